@@ -1,0 +1,15 @@
+// Each subcommand registers itself on the CLI11 app; its work is done by a function in io/ (testable).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace pednav::apps {
+
+/// Callback run after parsing if its subcommand was chosen; returns the process exit code.
+using Action = std::function<int()>;
+
+void add_config_check_command(CLI::App& app, Action& action);
+void add_rinex_info_command(CLI::App& app, Action& action);
+
+}  // namespace pednav::apps

@@ -1,0 +1,17 @@
+// The three callbacks librtklib expects its executable to define. pednav reports through return values
+// instead, so they do nothing. Forced into every binary through -Wl,-u (gnss/CMakeLists.txt).
+extern "C" {
+#include "rtklib.h"
+}
+#undef lock
+#undef unlock
+#undef initlock
+#undef thread_t
+#undef lock_t
+#undef PI
+
+extern "C" {
+int showmsg(const char* /*format*/, ...) { return 0; }
+void settspan(gtime_t /*ts*/, gtime_t /*te*/) {}
+void settime(gtime_t /*time*/) {}
+}

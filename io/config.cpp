@@ -1,0 +1,110 @@
+#include "io/config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "io/yaml_schema.hpp"
+
+namespace pednav::io {
+
+Expected<RunConfig> parse_run_config(const std::string& yaml_text, const std::string& source_name,
+                                     const std::string& base_dir) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    return make_error(source_name + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+  }
+  auto problems = std::make_shared<YamlProblems>();
+  problems->file = source_name;
+  if (!root || root.IsNull()) return make_error(source_name + ": configuration is empty");
+  RunConfig cfg;
+  cfg.source_file = source_name;
+  {
+    YamlMap top(root, "", problems, base_dir);
+    top.choice("mode", cfg.mode, {"tc", "ins", "gnss"});
+    read_gnss_section(top, cfg.gnss);
+    read_imu_section(top, cfg.imu);
+    read_filter_section(top, cfg);
+    {
+      YamlMap ref = top.map("reference");
+      ref.path("file", cfg.reference.file, top.has("reference"));
+      ref.choice("format", cfg.reference.format, {"csv", "pos", "nmea"});
+    }
+    {
+      YamlMap out = top.map("output");
+      out.number("rate_hz", cfg.output.rate_hz, false, 1e-6, 1000.0);
+      out.strings("formats", cfg.output.formats);
+      for (const auto& f : cfg.output.formats) {
+        if (f != "csv" && f != "pos") out.problem("formats", "unknown output format '" + f + "' (expected csv, pos)");
+      }
+    }
+    // Mode-dependent required inputs.
+    if (cfg.mode != "ins") {
+      if (cfg.gnss.rover_obs.empty() && !top.has("rover_obs")) top.problem("rover_obs", "required key is missing (mode " + cfg.mode + ")");
+      if (cfg.gnss.nav.empty() && !top.has("nav")) top.problem("nav", "required key is missing (mode " + cfg.mode + ")");
+    }
+    if (cfg.mode != "gnss" && cfg.imu.file.empty() && !top.has("imu")) {
+      top.problem("imu", "required key is missing (mode " + cfg.mode + ")");
+    }
+    top.finish();
+  }
+  if (!problems->empty()) return make_error(problems->joined());
+  return cfg;
+}
+
+Expected<RunConfig> load_run_config(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return make_error(path + ": cannot open configuration file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::filesystem::path p(path);
+  return parse_run_config(ss.str(), path, p.parent_path().empty() ? "." : p.parent_path().string());
+}
+
+std::string to_yaml(const RunConfig& c) {
+  YAML::Emitter e;
+  e << YAML::BeginMap;
+  e << YAML::Key << "mode" << YAML::Value << c.mode;
+  if (!c.gnss.rover_obs.empty()) e << YAML::Key << "rover_obs" << YAML::Value << c.gnss.rover_obs;
+  if (!c.gnss.base_obs.empty()) e << YAML::Key << "base_obs" << YAML::Value << c.gnss.base_obs;
+  if (!c.gnss.nav.empty()) e << YAML::Key << "nav" << YAML::Value << c.gnss.nav;
+  if (c.gnss.base_position_ecef_m) {
+    const auto& b = *c.gnss.base_position_ecef_m;
+    e << YAML::Key << "base_position_ecef_m" << YAML::Value << YAML::Flow << std::vector<double>{b.x(), b.y(), b.z()};
+  }
+  e << YAML::Key << "gnss" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "systems" << YAML::Value << YAML::Flow << c.gnss.systems;
+  e << YAML::Key << "elevation_mask_deg" << YAML::Value << c.gnss.elevation_mask_rad * 180.0 / 3.14159265358979323846;
+  e << YAML::Key << "epoch_match_tolerance_s" << YAML::Value << c.gnss.epoch_match_tolerance_s;
+  e << YAML::Key << "max_base_age_s" << YAML::Value << c.gnss.max_base_age_s;
+  e << YAML::Key << "min_cn0_dbhz" << YAML::Value << c.gnss.min_cn0_dbhz;
+  e << YAML::EndMap;
+  if (!c.imu.file.empty()) {
+    e << YAML::Key << "imu" << YAML::Value << YAML::BeginMap << YAML::Key << "file" << YAML::Value << c.imu.file;
+    if (!c.imu.format_preset.empty()) e << YAML::Key << "format" << YAML::Value << c.imu.format_preset;
+    if (!c.imu.spec_preset.empty()) e << YAML::Key << "spec" << YAML::Value << c.imu.spec_preset;
+    e << YAML::EndMap;
+  }
+  if (!c.reference.file.empty()) {
+    e << YAML::Key << "reference" << YAML::Value << YAML::BeginMap << YAML::Key << "file" << YAML::Value
+      << c.reference.file << YAML::Key << "format" << YAML::Value << c.reference.format << YAML::EndMap;
+  }
+  e << YAML::Key << "mechanization_rate_hz" << YAML::Value << c.mechanization_rate_hz;
+  e << YAML::Key << "zupt" << YAML::Value << YAML::BeginMap << YAML::Key << "detector" << YAML::Value
+    << c.zupt.detector << YAML::Key << "form" << YAML::Value << c.zupt.form << YAML::EndMap;
+  e << YAML::Key << "fault_rejection" << YAML::Value << YAML::BeginMap << YAML::Key << "probability"
+    << YAML::Value << c.fault_rejection_probability << YAML::EndMap;
+  e << YAML::Key << "smoother" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled" << YAML::Value
+    << c.smoother_enabled << YAML::EndMap;
+  e << YAML::Key << "output" << YAML::Value << YAML::BeginMap << YAML::Key << "rate_hz" << YAML::Value
+    << c.output.rate_hz << YAML::Key << "formats" << YAML::Value << YAML::Flow << c.output.formats << YAML::EndMap;
+  e << YAML::EndMap;
+  return std::string(e.c_str()) + "\n";
+}
+
+}  // namespace pednav::io

@@ -1,0 +1,85 @@
+// Run configuration: YAML -> validated options (SI inside; non-SI YAML keys carry their unit suffix).
+// The YAML vocabulary is documented in README.md ("Configuration"). Sections live in io/config_<section>.cpp.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/expected.hpp"
+
+namespace YAML {
+class Node;
+}
+
+namespace pednav::io {
+
+class YamlMap;
+
+/// `gnss:` section and the top-level GNSS file keys.
+struct GnssConfig {
+  std::string rover_obs;                 ///< rover RINEX obs (top-level key rover_obs)
+  std::string base_obs;                  ///< base RINEX obs, empty = undifferenced (top-level key base_obs)
+  std::vector<std::string> nav;          ///< RINEX nav files, merged (top-level key nav)
+  std::optional<Eigen::Vector3d> base_position_ecef_m;  ///< else the base RINEX header (approximate)
+  std::vector<std::string> systems{"G"}; ///< G R E C J
+  double elevation_mask_rad = 10.0 * 3.14159265358979323846 / 180.0;  ///< key elevation_mask_deg
+  double epoch_match_tolerance_s = 0.1;  ///< rover/base epochs closer than this are simultaneous
+  double max_base_age_s = 30.0;          ///< older base epochs are not propagated
+  double min_cn0_dbhz = 0.0;             ///< signals below are not used
+};
+
+/// `imu:` section.
+struct ImuConfig {
+  std::string file;
+  std::string format_preset;  ///< a preset name from datasets/imu_formats (empty = column map below)
+  std::string spec_preset;    ///< IMU noise preset name
+};
+
+/// `reference:` section.
+struct ReferenceConfig {
+  std::string file;
+  std::string format = "csv";  ///< csv | pos | nmea
+};
+
+/// `zupt:` section.
+struct ZuptConfig {
+  std::string detector = "mv";  ///< mv (seed 004 eq. 1) | shoe | hmm
+  std::string form = "D";       ///< D (seed 001 eq. 8) | F (seed 001 eq. 9)
+};
+
+/// `output:` section.
+struct OutputConfig {
+  double rate_hz = 1.0;                      ///< solution rows per second
+  std::vector<std::string> formats{"csv", "pos"};
+};
+
+/// Everything one run needs, resolved (paths absolute or relative to the working directory).
+struct RunConfig {
+  std::string source_file;      ///< the YAML file this came from
+  std::string mode = "tc";      ///< tc | ins | gnss
+  GnssConfig gnss;
+  ImuConfig imu;
+  ReferenceConfig reference;
+  double mechanization_rate_hz = 20.0;
+  ZuptConfig zupt;
+  double fault_rejection_probability = 0.999;  ///< chi-square test probability of the innovation check
+  bool smoother_enabled = true;
+  OutputConfig output;
+};
+
+/// Read and validate a run configuration; every problem is reported at once ("file:line: yaml.path: what").
+Expected<RunConfig> load_run_config(const std::string& path);
+/// Same from YAML text; `source_name` names it in messages, `base_dir` resolves relative paths.
+Expected<RunConfig> parse_run_config(const std::string& yaml_text, const std::string& source_name,
+                                     const std::string& base_dir);
+/// The resolved configuration as YAML (written next to the outputs as config.resolved.yaml).
+std::string to_yaml(const RunConfig& config);
+
+// Section readers (one file each): read keys of `map` into `out`, reporting problems through `map`.
+void read_gnss_section(YamlMap& top, GnssConfig& out);
+void read_imu_section(YamlMap& top, ImuConfig& out);
+void read_filter_section(YamlMap& top, RunConfig& out);
+
+}  // namespace pednav::io

@@ -1,0 +1,35 @@
+// YAML section reader: GNSS files (top level) and the `gnss:` options.
+#include "io/config.hpp"
+#include "io/yaml_schema.hpp"
+
+namespace pednav::io {
+
+void read_gnss_section(YamlMap& top, GnssConfig& out) {
+  top.path("rover_obs", out.rover_obs);
+  top.path("base_obs", out.base_obs);
+  top.paths("nav", out.nav);
+  if (top.has("base_position_ecef_m")) {
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    top.vector3("base_position_ecef_m", b);
+    if (b.norm() < 6.0e6 || b.norm() > 6.5e6) {
+      top.problem("base_position_ecef_m", "is not an ECEF position near the Earth's surface (|p| must be 6000-6500 km)");
+    } else {
+      out.base_position_ecef_m = b;
+    }
+  }
+  YamlMap g = top.map("gnss");
+  g.strings("systems", out.systems);
+  for (const auto& s : out.systems) {
+    if (s != "G" && s != "R" && s != "E" && s != "C" && s != "J") {
+      g.problem("systems", "unknown system '" + s + "' (expected G, R, E, C or J)");
+    }
+  }
+  double mask_deg = out.elevation_mask_rad * 180.0 / 3.14159265358979323846;
+  g.number("elevation_mask_deg", mask_deg, false, 0.0, 90.0);
+  out.elevation_mask_rad = mask_deg * 3.14159265358979323846 / 180.0;
+  g.number("epoch_match_tolerance_s", out.epoch_match_tolerance_s, false, 0.0, 10.0);
+  g.number("max_base_age_s", out.max_base_age_s, false, 0.0, 3600.0);
+  g.number("min_cn0_dbhz", out.min_cn0_dbhz, false, 0.0, 70.0);
+}
+
+}  // namespace pednav::io

@@ -1,0 +1,75 @@
+// Strict YAML mapping reader: every problem (unknown key, wrong type, missing key, out of range) is collected
+// with its file:line and YAML path, so a config is rejected with all of its problems at once.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <initializer_list>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace pednav::io {
+
+/// Problems found while reading one YAML file.
+struct YamlProblems {
+  std::string file;
+  std::vector<std::string> messages;
+  void add(const YAML::Node& where, const std::string& path, const std::string& what);
+  bool empty() const { return messages.empty(); }
+  std::string joined() const;  ///< one problem per line
+};
+
+/// A view of one YAML mapping at a path ("imu.spec"). Keys read through it are marked as known; finish()
+/// reports every other key as unknown.
+class YamlMap {
+ public:
+  YamlMap(YAML::Node node, std::string path, std::shared_ptr<YamlProblems> problems,
+          std::filesystem::path base_dir);
+  ~YamlMap();
+  YamlMap(YamlMap&&) = default;
+  YamlMap(const YamlMap&) = delete;
+  YamlMap& operator=(const YamlMap&) = delete;
+
+  bool has(const std::string& key) const;
+  /// Child mapping; an absent optional child is an empty mapping.
+  YamlMap map(const std::string& key, bool required = false);
+
+  void number(const std::string& key, double& out, bool required = false, double min = -1e300, double max = 1e300);
+  void integer(const std::string& key, int& out, bool required = false, int min = -2147483647, int max = 2147483647);
+  void boolean(const std::string& key, bool& out, bool required = false);
+  void text(const std::string& key, std::string& out, bool required = false);
+  /// A string that must be one of `allowed`.
+  void choice(const std::string& key, std::string& out, std::initializer_list<const char*> allowed,
+              bool required = false);
+  /// A path, resolved relative to the config file's folder.
+  void path(const std::string& key, std::string& out, bool required = false);
+  /// A path or a list of paths.
+  void paths(const std::string& key, std::vector<std::string>& out, bool required = false);
+  void strings(const std::string& key, std::vector<std::string>& out, bool required = false);
+  void numbers(const std::string& key, std::vector<double>& out, bool required = false);
+  void vector3(const std::string& key, Eigen::Vector3d& out, bool required = false);
+  /// Mark a key as known without reading it (the caller reads the node itself).
+  YAML::Node raw(const std::string& key);
+  /// Report an out-of-range/inconsistent value of a key that was already read.
+  void problem(const std::string& key, const std::string& what);
+  /// Report unknown keys (called by the destructor if not called explicitly).
+  void finish();
+  const std::string& yaml_path() const { return path_; }
+
+ private:
+  YAML::Node get(const std::string& key, bool required);
+  std::string key_path(const std::string& key) const;
+
+  YAML::Node node_;
+  std::string path_;
+  std::shared_ptr<YamlProblems> problems_;
+  std::filesystem::path base_dir_;
+  std::set<std::string> known_;
+  bool finished_ = false;
+};
+
+}  // namespace pednav::io

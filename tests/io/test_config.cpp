@@ -1,0 +1,96 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "io/config.hpp"
+
+namespace pednav::io {
+namespace {
+
+using ::testing::HasSubstr;
+
+Expected<RunConfig> parse(const std::string& text) { return parse_run_config(text, "cfg.yaml", "/data/run"); }
+
+TEST(Config, MinimalGnssConfigResolvesPaths) {
+  auto cfg = parse("mode: gnss\nrover_obs: rover.obs\nbase_obs: /abs/base.obs\nnav: [a.nav, ../b.nav]\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->gnss.rover_obs, "/data/run/rover.obs");
+  EXPECT_EQ(cfg->gnss.base_obs, "/abs/base.obs");
+  ASSERT_EQ(cfg->gnss.nav.size(), 2u);
+  EXPECT_EQ(cfg->gnss.nav[1], "/data/b.nav");
+  EXPECT_DOUBLE_EQ(cfg->mechanization_rate_hz, 20.0);
+  EXPECT_EQ(cfg->zupt.form, "D");
+}
+
+TEST(Config, UnknownKeyIsAnErrorWithPathAndLine) {
+  auto cfg = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\ngnss:\n  elevation_mask: 10\n");
+  ASSERT_FALSE(cfg);
+  EXPECT_THAT(cfg.error().message, HasSubstr("cfg.yaml:5: gnss.elevation_mask: unknown key"));
+}
+
+TEST(Config, WrongTypeNegativeRateAndBadEnumAreAllReportedAtOnce) {
+  auto cfg = parse(
+      "mode: gnss\nrover_obs: r.obs\nnav: n.nav\nmechanization_rate_hz: -5\n"
+      "gnss:\n  elevation_mask_deg: ten\nzupt:\n  form: E\nsmoother:\n  enabled: maybe\n");
+  ASSERT_FALSE(cfg);
+  const std::string& m = cfg.error().message;
+  EXPECT_THAT(m, HasSubstr("cfg.yaml:4: mechanization_rate_hz: value -5 is out of range"));
+  EXPECT_THAT(m, HasSubstr("gnss.elevation_mask_deg: expected a finite number, got 'ten'"));
+  EXPECT_THAT(m, HasSubstr("zupt.form: expected one of {D, F}, got 'E'"));
+  EXPECT_THAT(m, HasSubstr("smoother.enabled: expected true or false, got 'maybe'"));
+}
+
+TEST(Config, MissingRequiredKeysDependOnMode) {
+  auto gnss = parse("mode: gnss\n");
+  ASSERT_FALSE(gnss);
+  EXPECT_THAT(gnss.error().message, HasSubstr("rover_obs: required key is missing (mode gnss)"));
+  EXPECT_THAT(gnss.error().message, HasSubstr("nav: required key is missing (mode gnss)"));
+  auto ins = parse("mode: ins\n");
+  ASSERT_FALSE(ins);
+  EXPECT_THAT(ins.error().message, HasSubstr("imu: required key is missing (mode ins)"));
+  auto imu_without_file = parse("mode: ins\nimu:\n  format: pyshoe\n");
+  ASSERT_FALSE(imu_without_file);
+  EXPECT_THAT(imu_without_file.error().message, HasSubstr("imu.file: required key is missing"));
+}
+
+TEST(Config, BasePositionMustBeEcef) {
+  auto cfg = parse("mode: gnss\nrover_obs: r\nnav: n\nbase_position_ecef_m: [53.2, -9.0, 66.8]\n");
+  ASSERT_FALSE(cfg);
+  EXPECT_THAT(cfg.error().message, HasSubstr("base_position_ecef_m: is not an ECEF position"));
+  auto ok = parse("mode: gnss\nrover_obs: r\nnav: n\nbase_position_ecef_m: [3774085.6456, -601662.5769, 5089316.3970]\n");
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_NEAR(ok->gnss.base_position_ecef_m->y(), -601662.5769, 1e-9);
+}
+
+TEST(Config, SyntaxErrorAndEmptyAndMissingFile) {
+  auto bad = parse("mode: [gnss\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("cfg.yaml:"));
+  EXPECT_THAT(bad.error().message, HasSubstr("YAML syntax error"));
+  auto empty = parse("");
+  ASSERT_FALSE(empty);
+  EXPECT_THAT(empty.error().message, HasSubstr("cfg.yaml: configuration is empty"));
+  auto missing = load_run_config("/nonexistent/dir/run.yaml");
+  ASSERT_FALSE(missing);
+  EXPECT_THAT(missing.error().message, HasSubstr("/nonexistent/dir/run.yaml: cannot open configuration file"));
+  auto not_a_map = parse("- a\n- b\n");
+  ASSERT_FALSE(not_a_map);
+  EXPECT_THAT(not_a_map.error().message, HasSubstr("(top level): expected a mapping"));
+}
+
+TEST(Config, ResolvedYamlParsesBackToTheSameConfig) {
+  auto cfg = parse(
+      "mode: tc\nrover_obs: r.obs\nnav: [n.nav]\nimu:\n  file: imu.csv\n  spec: crista\n"
+      "gnss:\n  systems: [G, R]\n  elevation_mask_deg: 15\nzupt:\n  form: F\nsmoother:\n  enabled: false\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  auto again = parse_run_config(to_yaml(*cfg), "resolved.yaml", "/elsewhere");
+  ASSERT_TRUE(again) << again.error().message << "\n" << to_yaml(*cfg);
+  EXPECT_EQ(again->gnss.rover_obs, "/data/run/r.obs");
+  EXPECT_EQ(again->gnss.systems, (std::vector<std::string>{"G", "R"}));
+  EXPECT_NEAR(again->gnss.elevation_mask_rad, cfg->gnss.elevation_mask_rad, 1e-12);
+  EXPECT_EQ(again->zupt.form, "F");
+  EXPECT_FALSE(again->smoother_enabled);
+  EXPECT_EQ(again->imu.spec_preset, "crista");
+}
+
+}  // namespace
+}  // namespace pednav::io
