@@ -133,7 +133,11 @@ DiscreteErrorModel discretize(const ContinuousErrorModel& model, double dt_s, Qd
   DiscreteErrorModel d;
   d.Phi = Eigen::MatrixXd::Identity(n, n) + Fdt + 0.5 * Fdt * Fdt;
   const Eigen::MatrixXd GQGt = model.G * model.Q * model.G.transpose();
-  if (method == QdMethod::kTrapezoidal) {
+  if (method == QdMethod::kSeries) {
+    const Eigen::MatrixXd FS = model.F * GQGt;
+    d.Qd = GQGt * dt_s + 0.5 * (FS + FS.transpose()) * dt_s * dt_s +
+           (model.F * GQGt * model.F.transpose()) * (dt_s * dt_s * dt_s / 3.0);
+  } else if (method == QdMethod::kTrapezoidal) {
     d.Qd = 0.5 * (d.Phi * GQGt * d.Phi.transpose() + GQGt) * dt_s;
   } else {
     // Van Loan (1978): A = [[-F, GQG^T], [0, F^T]] Δt, B = exp(A); Φ = B22^T, Qd = Φ B12.

@@ -73,7 +73,9 @@ ContinuousErrorModel continuous_error_model(const ErrorStateLayout& layout, cons
 
 /// Discretization methods of Qd (docs/error_state.md §5).
 enum class QdMethod {
-  kTrapezoidal,  ///< Qd = 1/2 (Φ G Q G^T Φ^T + G Q G^T) Δt   (default: O(Δt^3) error, cheap)
+  kSeries,       ///< Qd = S Δt + (F S + S F^T) Δt²/2 + F S F^T Δt³/3, S = G Q G^T (default: Van Loan's integral
+                 ///< to third order in Δt; cheap and gets the position-noise term S_vv Δt³/3 right)
+  kTrapezoidal,  ///< Qd = 1/2 (Φ S Φ^T + S) Δt (common, but its position block is 3/2 of the exact one)
   kVanLoan,      ///< exact for constant F over Δt (matrix exponential of the 2n x 2n Van Loan matrix)
 };
 
@@ -84,14 +86,14 @@ struct DiscreteErrorModel {
 };
 
 /// Discretize a continuous model over dt_s [s].
-DiscreteErrorModel discretize(const ContinuousErrorModel& model, double dt_s, QdMethod method = QdMethod::kTrapezoidal);
+DiscreteErrorModel discretize(const ContinuousErrorModel& model, double dt_s, QdMethod method = QdMethod::kSeries);
 
 /// The discrete model of one mechanization interval: F at the interval mid-point (attitude halfway, mean
 /// specific force of the increment), so that Φ matches mechanize() to first order. `before` at inc.t0,
 /// `after` = mechanize(before, corrected inc); `inc` is the corrected increment.
 DiscreteErrorModel interval_error_model(const ErrorStateLayout& layout, const ImuSpec& spec, const NavState& before,
                                         const NavState& after, const ImuIncrement& inc,
-                                        QdMethod method = QdMethod::kTrapezoidal);
+                                        QdMethod method = QdMethod::kSeries);
 
 /// Initial error covariance (diagonal) from 1-sigma position [m], velocity [m/s], attitude [rad] per axis and
 /// the spec's turn-on biases / scale-factor sigmas; other registered blocks are left zero for their owners.

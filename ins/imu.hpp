@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <vector>
 
@@ -24,8 +25,9 @@ struct ImuIncrement {
   double dt_s = 0.0;                                        ///< t1 - t0 [s]
   Eigen::Vector3d alpha_b = Eigen::Vector3d::Zero();        ///< plain angle increment  ∫ω dt [rad]
   Eigen::Vector3d upsilon_b = Eigen::Vector3d::Zero();      ///< plain velocity increment ∫f dt [m/s]
-  Eigen::Vector3d dtheta_b = Eigen::Vector3d::Zero();       ///< rotation vector b(t0)->b(t1), coning-compensated [rad]
-  Eigen::Vector3d dv_b = Eigen::Vector3d::Zero();           ///< specific-force velocity change in b(t0) with rotation + sculling compensation [m/s]
+  Eigen::Vector3d dtheta_b = Eigen::Vector3d::Zero();       ///< rotation vector of R_b(t0)_b(t1) (coning included) [rad]
+  Eigen::Vector3d dv_b = Eigen::Vector3d::Zero();           ///< ∫ R_b(t0)_b(t) f dt: velocity increment in b(t0), rotation + sculling included [m/s]
+  Eigen::Vector3d dp_b = Eigen::Vector3d::Zero();           ///< ∫∫ R_b(t0)_b(s) f ds dt: position increment in b(t0) (scrolling included) [m]
   Eigen::Vector3d omega_end_b = Eigen::Vector3d::Zero();    ///< rate at t1 [rad/s] (for scale-factor Jacobians / detectors)
   Eigen::Vector3d f_end_b = Eigen::Vector3d::Zero();        ///< specific force at t1 [m/s^2]
   int samples = 0;                                          ///< IMU sub-intervals accumulated
@@ -34,14 +36,16 @@ struct ImuIncrement {
 /// Options of the increment integrator.
 struct IncrementOptions {
   double rate_hz = 20.0;        ///< mechanization rate [Hz]; interval ends lie on the GPST grid k / rate_hz
-  bool coning = true;           ///< add the coning correction (otherwise dtheta = alpha)
-  bool sculling = true;         ///< add the rotation + sculling correction (otherwise dv = upsilon)
+  bool coning = true;           ///< compose the sub-interval rotations (otherwise dtheta = alpha: no coning correction)
+  bool sculling = true;         ///< rotate sub-interval velocity/position increments (otherwise dv = upsilon, dp = upsilon dt/2)
 };
 
 /// Accumulates IMU samples (any rate, irregular spacing allowed) into increments over mechanization intervals.
-/// Between two samples the rate and specific force are taken as linear in time (trapezoid); an interval end
-/// that falls between samples is served by linear interpolation of the two samples. Any mechanization rate up
-/// to (and above) the IMU rate works. Coning/sculling: second-order recursive algorithms, docs/ins.md eq. (2.3)-(2.6).
+/// Between two samples the rate and specific force are taken as linear in time; an interval end that falls
+/// between samples is served by linear interpolation of the two samples. Any mechanization rate up to (and
+/// above) the IMU rate works. Coning, sculling and scrolling are handled by a two-speed structure (Savage 1998):
+/// the body-frame rotation, velocity and position increments are composed at the IMU rate (second-order
+/// sub-interval terms, docs/ins.md eq. 2.1-2.6); the Earth/gravity part runs at the mechanization rate.
 /// Interval ends lie on the GPST grid of integer multiples of the period (1e9/rate_hz ns, rounded).
 class IncrementIntegrator {
  public:
@@ -84,6 +88,7 @@ class IncrementIntegrator {
   ImuSample last_;
   ImuIncrement cur_;
   ImuIncrement done_;
+  Eigen::Quaterniond q_acc_ = Eigen::Quaterniond::Identity();  // R_b(t0)_b(current)
   GpsTime next_end_;
 };
 

@@ -26,12 +26,13 @@ ImuIncrement correct_increment(const ImuIncrement& inc, const ImuErrors& errors)
 ImuSample correct_sample(const ImuSample& sample, const ImuErrors& errors);
 
 /// Specific-force velocity increment over the interval resolved in e [m/s]: R_e_b(t0) dv_b minus the
-/// Earth-rate frame-rotation term 1/2 omega_ie x (R_e_b upsilon) dt (Groves 2013 §5.5.2). `prev` at inc.t0.
+/// Earth-rate frame-rotation term omega_ie x R_e_b (dv_b dt - dp_b) (Groves 2013 §5.5.2). `prev` at inc.t0.
 Eigen::Vector3d specific_force_increment_e(const NavState& prev, const ImuIncrement& inc);
 
 /// One precise ECEF mechanization step from prev (at inc.t0) to inc.t1: attitude with Earth rate (exact for a
-/// constant Earth rate), specific-force transformation, velocity with J2 gravity at the mid-point and Coriolis
-/// with the mean velocity, trapezoidal position. docs/ins.md eq. (3.1)-(3.5).
+/// constant Earth rate), specific-force transformation, position from the double integral of specific force
+/// plus gravity and Coriolis, velocity with J2 gravity at the mid-point and Coriolis with the mean velocity.
+/// docs/ins.md eq. (3.1)-(3.5).
 NavState mechanize(const NavState& prev, const ImuIncrement& inc);
 
 }  // namespace pednav::ins

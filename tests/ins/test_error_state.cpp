@@ -1,0 +1,224 @@
+// Error-state model: layout, boxplus/boxminus, F against numerical differentiation through boxplus,
+// discrete Φ against the nonlinear mechanization over 1 s of foot motion, Qd discretizations.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/geodesy.hpp"
+#include "core/rotation.hpp"
+#include <Eigen/Eigenvalues>
+
+#include "ins/error_state.hpp"
+#include "ins/gravity.hpp"
+#include "motion.hpp"
+
+namespace pednav::ins {
+namespace {
+
+using ::testing::HasSubstr;
+
+ErrorStateLayout layout_with_scale() {
+  ErrorStateLayout l;
+  EXPECT_TRUE(l.add(kScaleGyroBlock, 3));
+  EXPECT_TRUE(l.add(kScaleAccBlock, 3));
+  EXPECT_TRUE(l.add("clock", 2));  // a block the INS model does not know: must stay untouched
+  return l;
+}
+
+TEST(ErrorStateLayout, CoreBlocksFixedOptionalBlocksAppended) {
+  ErrorStateLayout l;
+  EXPECT_EQ(l.dim(), 15);
+  EXPECT_EQ(l.find("att")->offset, kAtt.offset);
+  auto sg = l.add(kScaleGyroBlock, 3);
+  ASSERT_TRUE(sg);
+  EXPECT_EQ(sg->offset, 15);
+  EXPECT_EQ(l.dim(), 18);
+  auto dup = l.add(kScaleGyroBlock, 3);
+  ASSERT_FALSE(dup);
+  EXPECT_THAT(dup.error().message, HasSubstr("block 'scale_gyro' is already registered"));
+  auto bad = l.add("lever", 0);
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("must have dim >= 1"));
+  EXPECT_FALSE(l.find("nope"));
+}
+
+InsState sample_state() {
+  InsState x;
+  x.nav = test::nav_state_from_ll(GpsTime(), 51.0, -114.0, 1100.0, 0.3, -0.4, 2.0);
+  x.nav.v_eb_e = Eigen::Vector3d(1.2, -0.7, 0.4);
+  x.imu.b_g = Eigen::Vector3d(0.01, -0.02, 0.005);
+  x.imu.b_a = Eigen::Vector3d(0.05, 0.1, -0.08);
+  x.imu.s_g = Eigen::Vector3d(1e-3, -2e-3, 5e-4);
+  x.imu.s_a = Eigen::Vector3d(-1e-3, 3e-3, 2e-3);
+  return x;
+}
+
+TEST(ErrorState, BoxplusBoxminusRoundTrip) {
+  const auto l = layout_with_scale();
+  const InsState x = sample_state();
+  Eigen::VectorXd dx = Eigen::VectorXd::LinSpaced(l.dim(), -0.3, 0.3);
+  dx.tail(2).setZero();  // the clock block is not an INS block
+  const InsState y = boxplus(x, dx, l);
+  constexpr double kTolRoundTrip = 5e-9;  // ECEF coordinates ~6.4e6 m carry ~1e-9 m of double rounding
+  EXPECT_LT((boxminus(y, x, l) - dx).norm(), kTolRoundTrip);
+  // Convention check (docs/error_state.md): R_true = exp([φ×]) R_est.
+  const Eigen::Matrix3d expected = so3_exp(dx.segment<3>(kAtt.offset)) * x.nav.R_e_b();
+  EXPECT_LT((y.nav.R_e_b() - expected).norm(), 1e-12);
+}
+
+// True-state continuous dynamics advanced by one tiny Euler step h with measurements (omega_m, f_m):
+// ω = (ω_m - b_g)/(1 + s_g), f = (f_m - b_a)/(1 + s_a); Ṙ = R[ω×] - [ω_ie×]R; v̇ = R f + g - 2ω_ie×v; ṗ = v;
+// ḃ = -b/τ; ṡ = -s/τ_s (scale τ from the spec).
+InsState euler_step(const InsState& x, const Eigen::Vector3d& omega_m, const Eigen::Vector3d& f_m, const ImuSpec& sp,
+                    double h) {
+  const Eigen::Vector3d w_ie(0.0, 0.0, wgs84::kOmegaIE_radps);
+  const Eigen::Vector3d w = ((omega_m - x.imu.b_g).array() / (1.0 + x.imu.s_g.array())).matrix();
+  const Eigen::Vector3d f = ((f_m - x.imu.b_a).array() / (1.0 + x.imu.s_a.array())).matrix();
+  InsState y = x;
+  const Eigen::Matrix3d R = x.nav.R_e_b();
+  y.nav.p_eb_e += h * x.nav.v_eb_e;
+  y.nav.v_eb_e += h * (R * f + gravity_ecef(x.nav.p_eb_e) - 2.0 * w_ie.cross(x.nav.v_eb_e));
+  y.nav.q_e_b = (quat_exp(-w_ie * h) * x.nav.q_e_b * quat_exp(w * h)).normalized();
+  y.imu.b_g -= h * x.imu.b_g / sp.gyro_bias_tau_s;
+  y.imu.b_a -= h * x.imu.b_a / sp.accel_bias_tau_s;
+  y.imu.s_g -= h * x.imu.s_g / sp.scale_tau_s;
+  y.imu.s_a -= h * x.imu.s_a / sp.scale_tau_s;
+  return y;
+}
+
+TEST(ErrorState, ContinuousFMatchesNumericalDifferentiationThroughBoxplus) {
+  // F_num = (∂/∂δx [step(x ⊞ δx) ⊟ step(x)] - I) / h at δx = 0 (central differences, per-block steps).
+  constexpr double kH_s = 1e-3;
+  constexpr double kTolRel = 5e-3;   // J2 part of the gravity gradient is omitted in F (< 0.3 %)
+  constexpr double kTolAbs = 1e-6;   // O(h) terms of the Euler step ([ω_ie×] products, ~1e-7)
+  const auto l = layout_with_scale();
+  ImuSpec sp = *imu_spec_preset("crista");
+  sp.scale_tau_s = 1000.0;
+  const InsState x = sample_state();
+  const Eigen::Vector3d omega_m(2.0, -5.0, 1.0), f_m(8.0, -3.0, -12.0);
+  const InsState x1 = euler_step(x, omega_m, f_m, sp, kH_s);
+  Eigen::VectorXd steps(l.dim());
+  steps << Eigen::Vector3d::Constant(1.0), Eigen::Vector3d::Constant(1e-4), Eigen::Vector3d::Constant(1e-5),
+      Eigen::Vector3d::Constant(1e-5), Eigen::Vector3d::Constant(1e-5), Eigen::VectorXd::Constant(6, 1e-5),
+      Eigen::VectorXd::Constant(2, 1.0);
+  Eigen::MatrixXd J(l.dim(), l.dim());
+  for (int i = 0; i < l.dim(); ++i) {
+    Eigen::VectorXd d = Eigen::VectorXd::Zero(l.dim());
+    d(i) = steps(i);
+    const Eigen::VectorXd plus = boxminus(euler_step(boxplus(x, d, l), omega_m, f_m, sp, kH_s), x1, l);
+    const Eigen::VectorXd minus = boxminus(euler_step(boxplus(x, -d, l), omega_m, f_m, sp, kH_s), x1, l);
+    J.col(i) = (plus - minus) / (2.0 * steps(i));
+  }
+  Eigen::MatrixXd F_num = (J - Eigen::MatrixXd::Identity(l.dim(), l.dim())) / kH_s;
+  F_num.rightCols(2).setZero();  // clock block: not INS-owned
+  F_num.bottomRows(2).setZero();
+  // F at the corrected measurements (the model's ω_b, f_b are bias/scale-corrected).
+  const Eigen::Vector3d w = ((omega_m - x.imu.b_g).array() / (1.0 + x.imu.s_g.array())).matrix();
+  const Eigen::Vector3d f = ((f_m - x.imu.b_a).array() / (1.0 + x.imu.s_a.array())).matrix();
+  const auto model = continuous_error_model(l, sp, x.nav.R_e_b(), x.nav.p_eb_e, f, w);
+  for (const auto& [ri, rb] : l.blocks()) {
+    for (const auto& [ci, cb] : l.blocks()) {
+      const Eigen::MatrixXd a = model.F.block(rb.offset, cb.offset, rb.dim, cb.dim);
+      const Eigen::MatrixXd n = F_num.block(rb.offset, cb.offset, rb.dim, cb.dim);
+      EXPECT_LE((a - n).norm(), kTolAbs + kTolRel * n.norm()) << "F[" << ri << "," << ci << "]\nanalytic\n"
+                                                               << a << "\nnumeric\n" << n;
+    }
+  }
+  // The scale-factor Jacobian of the true rates is -diag(ω)/(1+s) ≈ -diag(ω): the tolerance above covers it.
+}
+
+TEST(ErrorState, DiscretePhiMatchesNonlinearPropagationOverOneSecondOfFootMotion) {
+  // Foot swing (pitch rate up to 7 rad/s), 400 Hz IMU, 20 Hz mechanization, 1 s. Estimated trajectory:
+  // mechanize with ImuErrors = 0. True trajectory: x0 ⊞ δx0 mechanized with the SAME increments corrected
+  // by the true errors δb, δs. Then δx(1 s) = true ⊟ est must equal Φ_20...Φ_1 δx0 up to
+  // (a) second-order terms, which scale with ε² when δx0 is scaled by ε, and (b) the discretization
+  // difference between Φ = I + FΔt + ½(FΔt)² (F at the interval mid-point) and the exact Jacobian of one
+  // mechanization step, which is linear in ε.
+  // Bound for (a): relative size ~ |φ| + |δb_g| t ≈ 3e-3 + 3e-3 = 6e-3 (products of attitude error with
+  //   specific force, of bias with rotation).
+  // Bound for (b): the bias columns use R_mid Δt for ∫R dt; the mismatch is (ω Δt)²/24 ≈ (7 · 0.05)²/24 ≈ 5e-3
+  //   relative at the peak pitch rate; other terms are O((FΔt)³/6) ≪ 1e-3.
+  // Sum: kTolRel = 1e-2. A wrong sign or a missing block gives O(1) relative residuals, and the prediction
+  // must beat "no propagation" (Φ = I) by a large factor.
+  constexpr double kTolRel = 1e-2;
+  constexpr double kMinGainOverIdentity = 50.0;
+  const test::FootMotion motion;
+  const double t_start = motion.still_s + motion.T * motion.stance_frac - 0.1;  // just before toe-off
+  auto all = motion.samples(400.0, t_start + 1.2);
+  std::vector<ImuSample> s;
+  for (const auto& x : all) {
+    if (x.t.seconds() >= t_start - 1e-9) s.push_back(x);
+  }
+  const auto incs = integrate_all(s, {20.0, true, true});
+  const auto l = layout_with_scale();
+  ImuSpec sp = *imu_spec_preset("crista");
+  // Constant sensor errors over the 1 s (the true errors are applied to the samples, which needs them fixed).
+  sp.gyro_bias_tau_s = sp.accel_bias_tau_s = sp.scale_tau_s = 1e12;
+  InsState est;
+  est.nav = test::nav_from_kinematics(incs.front().t0, motion.at(incs.front().t0.seconds()));
+  Eigen::VectorXd dx0 = Eigen::VectorXd::Zero(l.dim());
+  dx0 << 0.05, -0.03, 0.02, 0.01, -0.02, 0.015, 1e-3, -2e-3, 1.5e-3, 2e-3, -1e-3, 3e-3, 0.05, -0.04, 0.03, 1e-3,
+      -2e-3, 1e-3, 2e-3, 1e-3, -1e-3, 0.0, 0.0;
+  auto run = [&](double eps, double& rel_residual) {
+    InsState e = est;
+    InsState tr = boxplus(est, eps * dx0, l);
+    // The truth sees the measured samples corrected by its own sensor errors (exact, at the IMU rate).
+    std::vector<ImuSample> corrected;
+    for (const auto& x : s) corrected.push_back(correct_sample(x, tr.imu));
+    const auto incs_true = integrate_all(corrected, {20.0, true, true});
+    Eigen::MatrixXd Phi = Eigen::MatrixXd::Identity(l.dim(), l.dim());
+    double elapsed = 0.0;
+    for (size_t k = 0; k < incs.size(); ++k) {
+      if (elapsed >= 1.0 - 1e-9) break;
+      const NavState before = e.nav;
+      e.nav = mechanize(e.nav, incs[k]);
+      tr.nav = mechanize(tr.nav, incs_true[k]);
+      Phi = interval_error_model(l, sp, before, e.nav, incs[k]).Phi * Phi;
+      elapsed += incs[k].dt_s;
+    }
+    const Eigen::VectorXd actual = boxminus(tr, e, l);
+    const Eigen::VectorXd predicted = Phi * (eps * dx0);
+    rel_residual = (actual - predicted).norm() / actual.norm();
+    const double identity_residual = (actual - eps * dx0).norm();
+    EXPECT_GT(identity_residual, kMinGainOverIdentity * (actual - predicted).norm());
+    std::printf("[phi 1 s foot] eps %.2f: |dx(1s)| %.4e, |Phi dx0 - dx| %.3e (relative %.2e); pos %.3e vel %.3e att %.3e\n",
+                eps, actual.norm(), (actual - predicted).norm(), rel_residual,
+                (actual - predicted).segment<3>(0).norm(), (actual - predicted).segment<3>(3).norm(),
+                (actual - predicted).segment<3>(6).norm());
+    return (actual - predicted).norm();
+  };
+  double rel1 = 0, rel_half = 0;
+  run(1.0, rel1);
+  run(0.5, rel_half);
+  EXPECT_LT(rel1, kTolRel);
+  EXPECT_LT(rel_half, kTolRel);
+}
+
+TEST(ErrorState, SeriesQdAgreesWithVanLoanAt20Hz) {
+  constexpr double kTolRel = 2e-3;  // Van Loan's O(Δt⁴) terms (attitude noise reaching v and p through [f×])
+  const auto l = layout_with_scale();
+  ImuSpec sp = *imu_spec_preset("gx5_25");
+  sp.scale_tau_s = 1000.0;
+  sp.gyro_scale_sigma = 1e-3;
+  const InsState x = sample_state();
+  const auto m = continuous_error_model(l, sp, x.nav.R_e_b(), x.nav.p_eb_e, Eigen::Vector3d(3, -2, -9.8),
+                                        Eigen::Vector3d(1, 4, -0.5));
+  const auto trap = discretize(m, 0.05, QdMethod::kSeries);
+  const auto trapz = discretize(m, 0.05, QdMethod::kTrapezoidal);
+  const auto vl = discretize(m, 0.05, QdMethod::kVanLoan);
+  const double rel = (trap.Qd - vl.Qd).norm() / vl.Qd.norm();
+  const double rel_trapz = (trapz.Qd - vl.Qd).norm() / vl.Qd.norm();
+  const double pos_trapz = trapz.Qd.block(0, 0, 3, 3).trace() / vl.Qd.block(0, 0, 3, 3).trace();
+  std::printf("[Qd 20 Hz] series vs Van Loan %.2e; trapezoidal vs Van Loan %.2e (position block ratio %.3f)\n", rel,
+              rel_trapz, pos_trapz);
+  EXPECT_LT(rel, kTolRel);
+  EXPECT_LT((trap.Qd - trap.Qd.transpose()).norm(), 1e-18);
+  // Positive semi-definite.
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(trap.Qd);
+  EXPECT_GT(es.eigenvalues().minCoeff(), -1e-15);
+}
+
+}  // namespace
+}  // namespace pednav::ins

@@ -1,0 +1,159 @@
+// ECEF mechanization: gravity model, stationary drift (1 h), Schuler period, foot-like motion per rate.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+
+#include "core/geodesy.hpp"
+#include "ins/gravity.hpp"
+#include "ins/mechanization.hpp"
+#include "motion.hpp"
+
+namespace pednav::ins {
+namespace {
+
+using test::FootMotion;
+using test::nav_state_from_ll;
+
+constexpr double kTolGravity_mps2 = 1.5e-4;  // vs Somigliana at h = 0; J2-only truncation reaches 1.2e-4 at the pole
+
+// Somigliana normal gravity (WGS84) at latitude [rad], h = 0: independent check of the J2 model.
+double somigliana(double lat) {
+  const double ge = 9.7803253359, k = 0.00193185265241, e2 = wgs84::kE2;
+  const double s2 = std::sin(lat) * std::sin(lat);
+  return ge * (1 + k * s2) / std::sqrt(1 - e2 * s2);
+}
+
+TEST(Gravity, MatchesSomiglianaAndPointsAlongEllipsoidNormal) {
+  for (double lat_deg : {0.0, 30.0, 45.0, 60.0, 89.9}) {
+    const double lat = lat_deg * kDegToRad;
+    const Eigen::Vector3d p = ecef_from_geodetic({lat, 0.3, 0.0});
+    const Eigen::Vector3d g = gravity_ecef(p);
+    EXPECT_NEAR(g.norm(), somigliana(lat), kTolGravity_mps2) << lat_deg;
+    // Deflection from the ellipsoid normal (down) stays below 1e-5 rad with the J2 model.
+    const Eigen::Vector3d down = R_e_n(lat, 0.3).col(2);
+    EXPECT_LT(g.normalized().cross(down).norm(), 1e-5) << lat_deg;
+  }
+  // Free-air gradient about -3.086e-6 (m/s^2)/m.
+  const Eigen::Vector3d p0 = ecef_from_geodetic({0.8, 0.1, 0.0}), p1 = ecef_from_geodetic({0.8, 0.1, 1000.0});
+  EXPECT_NEAR((gravity_ecef(p1).norm() - gravity_ecef(p0).norm()) / 1000.0, -3.086e-6, 0.01e-6);
+}
+
+std::vector<ImuSample> stationary_samples(const NavState& s, double rate_hz, double duration_s) {
+  test::Kinematics k{s.p_eb_e, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), s.R_e_b(), Eigen::Vector3d::Zero()};
+  const ImuSample one = test::imu_from_kinematics(GpsTime(), k);
+  std::vector<ImuSample> out;
+  const int64_t step = std::llround(1e9 / rate_hz);
+  for (int64_t i = 0; i * step <= std::llround(duration_s * 1e9); ++i) {
+    ImuSample x = one;
+    x.t = s.t.plus_ns(i * step);
+    out.push_back(x);
+  }
+  return out;
+}
+
+NavState run(NavState s, const std::vector<ImuSample>& samples, double rate_hz,
+             const std::function<void(const NavState&)>& each = {}) {
+  IncrementIntegrator integ({rate_hz, true, true});
+  for (const auto& x : samples) {
+    integ.push(x, [&](const ImuIncrement& inc) {
+      s = mechanize(s, inc);
+      if (each) each(s);
+    });
+  }
+  return s;
+}
+
+TEST(Mechanization, StationaryOneHourDriftsLessThanOneCentimetre) {
+  constexpr double kTolHorizontal_m = 0.01;  // issue 12 "Done when"
+  const GpsTime t0 = GpsTime::from_week_tow(2000, 100.0);
+  const NavState s0 =
+      nav_state_from_ll(t0, 45.0, 7.0, 250.0, 0.1, -0.2, 1.0);  // tilted, heading 57 deg
+  const auto samples = stationary_samples(s0, 100.0, 3600.0);
+  double max_h = 0.0;
+  const NavState s1 = run(s0, samples, 20.0, [&](const NavState& s) {
+    const Eigen::Vector3d d = ned_from_ecef(s.p_eb_e, s0.p_eb_e);
+    max_h = std::max(max_h, d.head<2>().norm());
+  });
+  const Eigen::Vector3d d = ned_from_ecef(s1.p_eb_e, s0.p_eb_e);
+  std::printf("[stationary 1 h @20 Hz] max horizontal drift %.3e m, final vertical %.3e m\n", max_h, d.z());
+  EXPECT_LT(max_h, kTolHorizontal_m);
+  EXPECT_NEAR((s1.t - s0.t), 3600.0, 1e-9);
+}
+
+TEST(Mechanization, SchulerPeriodFromInitialVelocityError) {
+  // Equator, initial north velocity error 0.1 m/s, exact stationary IMU data: the north position error is
+  // (v0/ω_s) sin(ω_s t); its zero crossings give the period. Theory 2π sqrt(r/γ) ≈ 84.4 min (issue 12).
+  constexpr double kSchuler_s = 84.4 * 60.0;
+  constexpr double kTolRel = 0.01;
+  const NavState truth = nav_state_from_ll(GpsTime(), 0.0, 20.0, 0.0, 0.0, 0.0, 0.0);
+  NavState s = truth;
+  const Eigen::Matrix3d Ren = R_e_n(0.0, 20.0 * kDegToRad);
+  s.v_eb_e = Ren * Eigen::Vector3d(0.1, 0.0, 0.0);
+  const auto samples = stationary_samples(truth, 20.0, 1.15 * kSchuler_s);
+  std::vector<double> crossings;
+  double prev_n = 0.0, prev_t = 0.0, max_n = 0.0;
+  run(s, samples, 10.0, [&](const NavState& x) {
+    const double n = ned_from_ecef(x.p_eb_e, truth.p_eb_e).x();
+    const double t = x.t - truth.t;
+    max_n = std::max(max_n, n);
+    if (prev_t > 60.0 && ((prev_n > 0) != (n > 0))) crossings.push_back(prev_t + (t - prev_t) * prev_n / (prev_n - n));
+    prev_n = n;
+    prev_t = t;
+  });
+  ASSERT_GE(crossings.size(), 2u);
+  const double period = crossings[1];
+  std::printf("[schuler] half-period crossing %.1f s, full %.1f s = %.2f min (amplitude %.1f m)\n", crossings[0],
+              period, period / 60.0, max_n);
+  EXPECT_NEAR(period, kSchuler_s, kTolRel * kSchuler_s);
+  EXPECT_NEAR(2.0 * crossings[0], kSchuler_s, kTolRel * kSchuler_s);
+}
+
+struct RateResult {
+  double rate_hz, max_vs_full_m, end_vs_full_m, end_vs_truth_m, max_att_vs_full_rad;
+};
+
+TEST(Mechanization, FootMotionAtReducedRatesStaysNearFullRate) {
+  // 400 Hz exact IMU of the analytic gait (pitch rate peaks 7 rad/s), 60 s, mechanized at 10/20/50/100 Hz vs
+  // 400 Hz (full rate). Issue 12: 20 Hz within a few centimetres of full rate; all figures reported.
+  constexpr double kImuRate_hz = 400.0, kDuration_s = 60.0;
+  constexpr double kTol20Hz_m = 0.03;
+  const FootMotion motion;
+  const auto samples = motion.samples(kImuRate_hz, kDuration_s);
+  double peak_rate = 0.0;
+  for (const auto& x : samples) peak_rate = std::max(peak_rate, x.omega_ib_b.norm());
+  EXPECT_NEAR(peak_rate, 7.0, 0.3);
+  const NavState s0 = test::nav_from_kinematics(samples.front().t, motion.at(0.0));
+  // Full-rate solution at every 0.1 s (a grid point of every rate).
+  auto trace = [&](double rate) {
+    std::vector<NavState> out;
+    run(s0, samples, rate, [&](const NavState& s) {
+      if (s.t.ns() % 100'000'000 == 0) out.push_back(s);
+    });
+    return out;
+  };
+  const auto full = trace(kImuRate_hz);
+  const NavState truth_end = test::nav_from_kinematics(full.back().t, motion.at(full.back().t.seconds()));
+  std::printf("[foot 60 s] full-rate (400 Hz) end error vs truth %.4f m\n",
+              (full.back().p_eb_e - truth_end.p_eb_e).norm());
+  std::vector<RateResult> results;
+  for (double rate : {10.0, 20.0, 50.0, 100.0}) {
+    const auto tr = trace(rate);
+    ASSERT_EQ(tr.size(), full.size());
+    RateResult r{rate, 0, 0, 0, 0};
+    for (size_t i = 0; i < tr.size(); ++i) {
+      r.max_vs_full_m = std::max(r.max_vs_full_m, (tr[i].p_eb_e - full[i].p_eb_e).norm());
+      r.max_att_vs_full_rad = std::max(r.max_att_vs_full_rad, tr[i].q_e_b.angularDistance(full[i].q_e_b));
+    }
+    r.end_vs_full_m = (tr.back().p_eb_e - full.back().p_eb_e).norm();
+    r.end_vs_truth_m = (tr.back().p_eb_e - truth_end.p_eb_e).norm();
+    results.push_back(r);
+    std::printf("[foot 60 s] %5.0f Hz: max |dp| vs full %.2e m, end %.2e m, end vs truth %.4f m, max att %.2e rad\n",
+                rate, r.max_vs_full_m, r.end_vs_full_m, r.end_vs_truth_m, r.max_att_vs_full_rad);
+  }
+  for (const auto& r : results) EXPECT_LT(r.max_vs_full_m, kTol20Hz_m) << r.rate_hz << " Hz";
+}
+
+}  // namespace
+}  // namespace pednav::ins
