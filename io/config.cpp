@@ -83,6 +83,10 @@ std::string to_yaml(const RunConfig& c) {
   e << YAML::Key << "epoch_match_tolerance_s" << YAML::Value << c.gnss.epoch_match_tolerance_s;
   e << YAML::Key << "max_base_age_s" << YAML::Value << c.gnss.max_base_age_s;
   e << YAML::Key << "min_cn0_dbhz" << YAML::Value << c.gnss.min_cn0_dbhz;
+  e << YAML::Key << "base_propagation" << YAML::Value << c.gnss.base_propagation;
+  e << YAML::Key << "code_sigma_zenith_m" << YAML::Value << c.gnss.code_sigma_zenith_m;
+  e << YAML::Key << "doppler_sigma_zenith_mps" << YAML::Value << c.gnss.doppler_sigma_zenith_mps;
+  e << YAML::Key << "cn0_ref_dbhz" << YAML::Value << c.gnss.cn0_ref_dbhz;
   e << YAML::EndMap;
   if (!c.imu.file.empty()) {
     e << YAML::Key << "imu" << YAML::Value << YAML::BeginMap << YAML::Key << "file" << YAML::Value << c.imu.file;

@@ -28,6 +28,10 @@ struct GnssConfig {
   double epoch_match_tolerance_s = 0.1;  ///< rover/base epochs closer than this are simultaneous
   double max_base_age_s = 30.0;          ///< older base epochs are not propagated
   double min_cn0_dbhz = 0.0;             ///< signals below are not used
+  std::string base_propagation = "ephemeris";  ///< older base epochs: ephemeris (exact geometry) | doppler
+  double code_sigma_zenith_m = 0.4;      ///< code noise at zenith and C/N0 >= cn0_ref_dbhz [m] (docs/gnss.md)
+  double doppler_sigma_zenith_mps = 0.05;///< range-rate noise at zenith and C/N0 >= cn0_ref_dbhz [m/s]
+  double cn0_ref_dbhz = 45.0;            ///< C/N0 above which the noise no longer decreases [dB-Hz]
 };
 
 /// `imu:` section.

@@ -1,0 +1,242 @@
+// `pednav gnss`: read rover/base/nav, match epochs, solve each epoch, write gnss.csv, gnss.pos, summary.json.
+#include "io/gnss_command.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+
+#include "core/geodesy.hpp"
+#include "gnss/ephemeris.hpp"
+#include "gnss/least_squares.hpp"
+#include "gnss/rtklib/rinex.hpp"
+#include "io/atomic_file.hpp"
+#include "io/log.hpp"
+#include "io/solution_writer.hpp"
+
+namespace pednav::io {
+namespace {
+
+gnss::SystemSelection selection(const std::vector<std::string>& systems) {
+  gnss::SystemSelection s;
+  s.gps = false;
+  for (const auto& l : systems) {
+    if (l == "G") s.gps = true;
+    if (l == "R") s.glonass = true;
+    if (l == "E") s.galileo = true;
+    if (l == "C") s.beidou = true;
+    if (l == "J") s.qzss = true;
+  }
+  return s;
+}
+
+// Error when the nav data has no ephemeris valid anywhere in the rover span for any observed satellite.
+Expected<void> check_nav_covers(const gnss::NavData& nav, const gnss::ObsData& rover, const std::string& nav_names) {
+  const GpsTime t0 = rover.epochs.front().time, t1 = rover.epochs.back().time;
+  for (const GpsTime t : {t0, GpsTime::from_ns((t0.ns() + t1.ns()) / 2), t1}) {
+    // The epoch nearest t with observations.
+    for (const auto& e : rover.epochs) {
+      if (e.time < t) continue;
+      int ok = 0;
+      for (const auto& s : e.sats) ok += gnss::satellite_state(nav, s.sat, t).has_value();
+      if (ok == 0 && !e.sats.empty()) {
+        GpsTime lo = GpsTime::from_ns(INT64_MAX), hi = GpsTime::from_ns(INT64_MIN);
+        for (const auto& k : nav.kepler) lo = std::min(lo, k.toe), hi = std::max(hi, k.toe);
+        for (const auto& g : nav.glonass) lo = std::min(lo, g.toe), hi = std::max(hi, g.toe);
+        return make_error(nav_names + ": navigation data do not cover the rover span " + t0.to_string() + " .. " +
+                          t1.to_string() + " (ephemeris toe " + lo.to_string() + " .. " + hi.to_string() +
+                          "; no satellite of the epoch at " + e.time.to_string() + " has a valid ephemeris)");
+      }
+      break;
+    }
+  }
+  return {};
+}
+
+std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.4f}", v) : "null"; }
+
+std::string summary_json(const GnssRunSummary& s, const RunConfig& c) {
+  std::string j = "{\n";
+  j += fmt::format("  \"mode\": \"{}\",\n", s.differential ? "single_difference" : "undifferenced");
+  j += fmt::format("  \"epochs_read\": {},\n  \"epochs_solved\": {},\n  \"epochs_with_velocity\": {},\n",
+                   s.epochs_read, s.epochs_solved, s.epochs_with_velocity);
+  j += fmt::format("  \"solved_pct\": {},\n",
+                   json_number(s.epochs_read ? 100.0 * s.epochs_solved / s.epochs_read : 0.0));
+  auto map_json = [](const std::map<std::string, int>& m) {
+    std::string o = "{";
+    bool first = true;
+    for (const auto& [k, v] : m) o += fmt::format("{}\"{}\": {}", first ? "" : ", ", k, v), first = false;
+    return o + "}";
+  };
+  j += "  \"epochs_not_solved\": " + map_json(s.not_solved) + ",\n";
+  j += "  \"satellites_rejected\": " + map_json(s.satellites_rejected) + ",\n";
+  j += fmt::format("  \"event_records_skipped\": {{\"rover\": {}, \"base\": {}}},\n", s.rover_event_records,
+                   s.base_event_records);
+  if (s.differential) {
+    const auto& a = s.base_age;
+    j += fmt::format(
+        "  \"base_age_s\": {{\"matched_epochs\": {}, \"simultaneous_epochs\": {}, \"unmatched_epochs\": {}, "
+        "\"mean\": {}, \"median\": {}, \"p95\": {}, \"max\": {}, \"histogram\": {{\"le_tolerance\": {}, "
+        "\"to_1\": {}, \"1_to_2\": {}, \"2_to_5\": {}, \"5_to_10\": {}, \"10_to_30\": {}, \"gt_30\": {}}}}},\n",
+        a.matched, a.simultaneous, a.unmatched, json_number(a.mean_s), json_number(a.median_s),
+        json_number(a.p95_s), json_number(a.max_s), a.histogram[0], a.histogram[1], a.histogram[2],
+        a.histogram[3], a.histogram[4], a.histogram[5], a.histogram[6]);
+    j += fmt::format("  \"base_position_source\": \"{}\",\n", s.base_position_from_header ? "rinex_header" : "config");
+    j += fmt::format("  \"base_propagation\": \"{}\",\n", c.gnss.base_propagation);
+  }
+  j += fmt::format("  \"wall_s\": {}\n}}\n", json_number(s.wall_s));
+  return j;
+}
+
+}  // namespace
+
+Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::string& out_dir) {
+  const auto start = std::chrono::steady_clock::now();
+  const GnssConfig& g = config.gnss;
+  if (g.rover_obs.empty()) return make_error(config.source_file + ": rover_obs is required for pednav gnss");
+  if (g.nav.empty()) return make_error(config.source_file + ": nav is required for pednav gnss");
+  const gnss::SystemSelection sel = selection(g.systems);
+
+  auto rover = gnss::read_rinex_obs(g.rover_obs, sel);
+  if (!rover) return rover.error();
+  if (rover->stats.truncated) {
+    return make_error(g.rover_obs + ": truncated: the last epoch record is incomplete (file cut off?)");
+  }
+  std::optional<gnss::ObsData> base;
+  if (!g.base_obs.empty()) {
+    auto b = gnss::read_rinex_obs(g.base_obs, sel);
+    if (!b) return b.error();
+    if (b->stats.truncated) return make_error(g.base_obs + ": truncated: the last epoch record is incomplete");
+    base = std::move(*b);
+  }
+  auto nav = gnss::read_rinex_nav(g.nav);
+  if (!nav) return nav.error();
+  std::string nav_names;
+  for (const auto& n : g.nav) nav_names += (nav_names.empty() ? "" : ", ") + n;
+  if (auto ok = check_nav_covers(*nav, *rover, nav_names); !ok) return ok.error();
+
+  GnssRunSummary sum;
+  sum.epochs_read = static_cast<int>(rover->epochs.size());
+  sum.rover_event_records = rover->stats.event_records;
+  sum.differential = base.has_value();
+
+  Eigen::Vector3d p_base = Eigen::Vector3d::Zero();
+  std::vector<gnss::BaseMatch> matches(rover->epochs.size());
+  if (base) {
+    sum.base_event_records = base->stats.event_records;
+    if (g.base_position_ecef_m) {
+      p_base = *g.base_position_ecef_m;
+    } else if (base->has_approx_position) {
+      p_base = base->approx_position_e;
+      sum.base_position_from_header = true;
+      spdlog::warn("{}: base position taken from the RINEX header APPROX POSITION XYZ ({:.3f}, {:.3f}, {:.3f}) m; "
+                   "it is approximate: set base_position_ecef_m for accurate results",
+                   g.base_obs, p_base.x(), p_base.y(), p_base.z());
+    } else {
+      return make_error(g.base_obs + ": no base position: the RINEX header has no APPROX POSITION XYZ and "
+                        "base_position_ecef_m is not set in " + config.source_file);
+    }
+    std::vector<GpsTime> rt, bt;
+    for (const auto& e : rover->epochs) rt.push_back(e.time);
+    for (const auto& e : base->epochs) bt.push_back(e.time);
+    matches = gnss::match_base_epochs(rt, bt, g.max_base_age_s);
+    sum.base_age = gnss::age_statistics(matches, g.epoch_match_tolerance_s);
+    if (sum.base_age.matched == 0) {
+      return make_error(g.base_obs + ": no base epoch within max_base_age_s = " + fmt::format("{}", g.max_base_age_s) +
+                        " s of any rover epoch (base " + bt.front().to_string() + " .. " + bt.back().to_string() +
+                        ", rover " + rt.front().to_string() + " .. " + rt.back().to_string() +
+                        "): base file from another day or time?");
+    }
+    // Common satellites at all?
+    bool any_common = false;
+    for (size_t i = 0; i < matches.size() && !any_common; ++i) {
+      if (matches[i].base_index < 0) continue;
+      for (const auto& rs : rover->epochs[i].sats) {
+        for (const auto& bs : base->epochs[matches[i].base_index].sats) any_common |= rs.sat == bs.sat;
+      }
+    }
+    if (!any_common) {
+      return make_error(g.rover_obs + " and " + g.base_obs +
+                        ": no common satellites in any matched epoch (check gnss.systems and the files)");
+    }
+  }
+
+  gnss::SolverOptions opt;
+  opt.elevation_mask_rad = g.elevation_mask_rad;
+  opt.min_cn0_dbhz = g.min_cn0_dbhz;
+  opt.fault_probability = config.fault_rejection_probability;
+  opt.weights.code_sigma_zenith_m = g.code_sigma_zenith_m;
+  opt.weights.doppler_sigma_zenith_mps = g.doppler_sigma_zenith_mps;
+  opt.weights.cn0_ref_dbhz = g.cn0_ref_dbhz;
+
+  std::vector<SolutionRow> rows;
+  rows.reserve(rover->epochs.size());
+  for (int r = 0; r < static_cast<int>(gnss::RejectReason::kCount); ++r) {
+    sum.satellites_rejected[gnss::reject_reason_name(static_cast<gnss::RejectReason>(r))] = 0;
+  }
+  Eigen::Vector3d p_prev = Eigen::Vector3d::Zero();
+  Progress progress("gnss", static_cast<int64_t>(rover->epochs.size()), progress_enabled());
+  for (size_t i = 0; i < rover->epochs.size(); ++i) {
+    progress.update(static_cast<int64_t>(i));
+    const gnss::ObsEpoch& re = rover->epochs[i];
+    gnss::EpochSolution sol;
+    std::optional<gnss::ObsEpoch> propagated;
+    const gnss::ObsEpoch* be = nullptr;
+    if (base) {
+      if (matches[i].base_index < 0) {
+        ++sum.not_solved[gnss::epoch_failure_name(gnss::EpochFailure::kNoBaseEpoch)];
+        continue;
+      }
+      be = &base->epochs[matches[i].base_index];
+      if (g.base_propagation == "doppler" && std::abs(matches[i].age_s) > g.epoch_match_tolerance_s) {
+        propagated = gnss::propagate_base_with_doppler(*be, re.time);
+        be = &*propagated;
+      }
+    }
+    sol = gnss::solve_epoch(*nav, re, be, p_base, p_prev, opt);
+    for (int r = 0; r < static_cast<int>(gnss::RejectReason::kCount); ++r) {
+      sum.satellites_rejected[gnss::reject_reason_name(static_cast<gnss::RejectReason>(r))] += sol.rejections[r];
+    }
+    if (!sol.ok()) {
+      ++sum.not_solved[gnss::epoch_failure_name(sol.failure)];
+      continue;
+    }
+    ++sum.epochs_solved;
+    p_prev = sol.p_ea_e;
+    SolutionRow row;
+    row.time = re.time;
+    row.p_e = sol.p_ea_e;
+    const Geodetic llh = geodetic_from_ecef(sol.p_ea_e);
+    const Eigen::Matrix3d R_ne = R_e_n(llh.lat, llh.lon).transpose();
+    if (sol.velocity_ok) {
+      row.v_n = R_ne * sol.v_ea_e;
+      ++sum.epochs_with_velocity;
+    }
+    row.cov_p_n = R_ne * sol.cov_p_e * R_ne.transpose();
+    row.n_sats_used = sol.n_sats_used;
+    row.n_sats_rejected = sol.n_sats_rejected;
+    row.pos_quality = base ? 4 : 5;
+    row.age_s = base ? matches[i].age_s : 0.0;
+    row.hdop = sol.dops.hdop;
+    row.pdop = sol.dops.pdop;
+    rows.push_back(row);
+  }
+  progress.finish();
+
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) return make_error(out_dir + ": cannot create the output folder: " + ec.message());
+  const std::string dir = out_dir + "/";
+  if (auto ok = write_solution_csv(dir + "gnss.csv", rows); !ok) return ok.error();
+  std::vector<std::string> comment{"pednav gnss " + config.source_file,
+                                   std::string("mode        : ") + (base ? "single-differenced code (DGPS)"
+                                                                         : "undifferenced code (single)")};
+  if (auto ok = write_solution_pos(dir + "gnss.pos", rows, comment); !ok) return ok.error();
+  sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (auto ok = write_file_atomic(dir + "summary.json", summary_json(sum, config)); !ok) return ok.error();
+  return sum;
+}
+
+}  // namespace pednav::io

@@ -1,0 +1,29 @@
+// `pednav gnss CONFIG.yaml -o OUT`: GNSS-only epoch-by-epoch least squares (SD with a base, else undifferenced)
+// -> gnss.csv, gnss.pos, summary.json (all written atomically).
+#pragma once
+
+#include <map>
+#include <string>
+
+#include "core/expected.hpp"
+#include "gnss/epoch_matching.hpp"
+#include "io/config.hpp"
+
+namespace pednav::io {
+
+/// Counts reported in summary.json.
+struct GnssRunSummary {
+  int epochs_read = 0, epochs_solved = 0, epochs_with_velocity = 0;
+  std::map<std::string, int> not_solved;          ///< reason -> epochs
+  std::map<std::string, int> satellites_rejected; ///< reason -> satellite-epochs
+  int rover_event_records = 0, base_event_records = 0;
+  bool differential = false;
+  bool base_position_from_header = false;
+  gnss::AgeStats base_age;
+  double wall_s = 0.0;
+};
+
+/// Run the GNSS-only solution for a loaded configuration and write the outputs into out_dir (created).
+Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::string& out_dir);
+
+}  // namespace pednav::io
