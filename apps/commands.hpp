@@ -11,6 +11,7 @@ using Action = std::function<int()>;
 
 void add_config_check_command(CLI::App& app, Action& action);
 void add_rinex_info_command(CLI::App& app, Action& action);
+void add_compare_command(CLI::App& app, Action& action);
 void add_gnss_command(CLI::App& app, Action& action);
 
 }  // namespace pednav::apps

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   pednav::apps::Action action;
   pednav::apps::add_config_check_command(app, action);
   pednav::apps::add_rinex_info_command(app, action);
+  pednav::apps::add_compare_command(app, action);
   pednav::apps::add_gnss_command(app, action);
 
   try {
