@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "core/expected.hpp"
+#include "ins/imu_spec.hpp"
+#include "io/imu_csv.hpp"
 
 namespace YAML {
 class Node;
@@ -39,6 +41,10 @@ struct ImuConfig {
   std::string file;
   std::string format_preset;  ///< a preset name from datasets/imu_formats (empty = column map below)
   std::string spec_preset;    ///< IMU noise preset name
+  ImuFormat format;           ///< resolved column map (preset or inline; README "IMU log format")
+  ins::ImuSpec spec;          ///< resolved noise model (preset, possibly overridden by inline keys)
+  bool has_format = false;    ///< imu.format was given
+  bool has_spec = false;      ///< imu.spec was given
 };
 
 /// `reference:` section.
@@ -85,5 +91,11 @@ std::string to_yaml(const RunConfig& config);
 void read_gnss_section(YamlMap& top, GnssConfig& out);
 void read_imu_section(YamlMap& top, ImuConfig& out);
 void read_filter_section(YamlMap& top, RunConfig& out);
+/// Read an IMU column map (keys of README "IMU log format") from `m` into `out`.
+void read_imu_format(YamlMap& m, ImuFormat& out);
+/// Read inline IMU spec keys (unit-suffixed, README "IMU spec") from `m` into `out` (SI).
+void read_imu_spec(YamlMap& m, ins::ImuSpec& out);
+/// A built-in IMU format preset (datasets/imu_formats/<name>.yaml), parsed.
+Expected<ImuFormat> imu_format_preset(const std::string& name);
 
 }  // namespace pednav::io

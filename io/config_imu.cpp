@@ -1,15 +1,202 @@
-// YAML section reader: `imu:` (log file, format, noise spec).
+// YAML section reader: `imu:` (log file, format = preset name or inline column map, spec = preset name or
+// inline unit-suffixed values). Keys are documented in README ("IMU log format", "IMU spec").
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <memory>
+
+#include "core/geodesy.hpp"
+#include "core/rotation.hpp"
 #include "io/config.hpp"
 #include "io/yaml_schema.hpp"
 
 namespace pednav::io {
+namespace {
+
+constexpr double kG0 = 9.80665;
+
+std::string joined_names(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& n : v) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+void read_columns(YamlMap& m, const char* key, std::array<int, 3>& out) {
+  std::vector<double> v;
+  m.numbers(key, v);
+  if (v.empty()) return;
+  if (v.size() != 3) {
+    m.problem(key, "expected 3 column indices, got " + std::to_string(v.size()));
+    return;
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (v[i] < 0 || v[i] != std::floor(v[i])) {
+      m.problem(key, "column indices are 0-based non-negative integers");
+      return;
+    }
+    out[i] = static_cast<int>(v[i]);
+  }
+}
+
+}  // namespace
+
+void read_imu_format(YamlMap& m, ImuFormat& out) {
+  std::string delim(1, out.delimiter);
+  m.text("delimiter", delim);
+  if (delim == "tab" || delim == "\\t") delim = "\t";
+  if (delim.size() != 1) {
+    m.problem("delimiter", "expected one character (or 'tab'), got '" + delim + "'");
+  } else {
+    out.delimiter = delim[0];
+  }
+  m.integer("header_lines", out.header_lines, false, 0, 1000);
+  {
+    YamlMap t = m.map("time");
+    t.choice("base", out.time_base, {"gps_sow", "gpst_unix", "relative", "index"});
+    t.integer("column", out.time_column, false, 0, 10000);
+    std::string unit = "s";
+    t.choice("unit", unit, {"s", "ms", "us", "ns"});
+    out.time_scale_s = unit == "s" ? 1.0 : unit == "ms" ? 1e-3 : unit == "us" ? 1e-6 : 1e-9;
+    t.integer("gps_week", out.gps_week, false, 0, 10000);
+    int start_week = -1;
+    double start_tow = 0.0;
+    t.integer("start_gps_week", start_week, false, 0, 10000);
+    t.number("start_gps_tow_s", start_tow, false, 0.0, 604800.0);
+    if (start_week >= 0) out.start_epoch = GpsTime::from_week_tow(start_week, start_tow);
+    if (t.has("start_gps_tow_s") && start_week < 0) t.problem("start_gps_week", "required with start_gps_tow_s");
+    t.number("rate_hz", out.index_rate_hz, false, 1e-3, 1e6);
+    if (out.time_base == "gps_sow" && out.gps_week < 0) t.problem("gps_week", "required key is missing (base gps_sow)");
+    if (out.time_base == "index" && !(out.index_rate_hz > 0)) t.problem("rate_hz", "required key is missing (base index)");
+  }
+  {
+    YamlMap g = m.map("gyro");
+    read_columns(g, "columns", out.gyro_columns);
+    g.choice("unit", out.gyro_unit, {"rad_per_s", "deg_per_s", "rad", "deg"});
+    g.vector3("signs", out.gyro_signs);
+    double fs_deg = out.gyro_full_scale * kRadToDeg;
+    g.number("full_scale_deg_per_s", fs_deg, false, 0.0, 1e5);
+    out.gyro_full_scale = fs_deg * kDegToRad;
+  }
+  {
+    YamlMap a = m.map("accel");
+    read_columns(a, "columns", out.accel_columns);
+    a.choice("unit", out.accel_unit, {"mps2", "g", "mps"});
+    a.vector3("signs", out.accel_signs);
+    double fs_g = out.accel_full_scale / kG0;
+    a.number("full_scale_g", fs_g, false, 0.0, 1e4);
+    out.accel_full_scale = fs_g * kG0;
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(out.gyro_signs(i)) != 1.0) m.problem("gyro", "signs must each be 1 or -1");
+    if (std::abs(out.accel_signs(i)) != 1.0) m.problem("accel", "signs must each be 1 or -1");
+  }
+  Eigen::Vector3d rpy_deg = Eigen::Vector3d::Zero();
+  if (m.has("mounting_rpy_deg")) {
+    m.vector3("mounting_rpy_deg", rpy_deg);
+    out.R_b_s = R_n_b_from_euler(rpy_deg.x() * kDegToRad, rpy_deg.y() * kDegToRad, rpy_deg.z() * kDegToRad);
+  } else {
+    m.raw("mounting_rpy_deg");
+  }
+  m.number("max_gap_s", out.max_gap_s, false, 1e-6, 3600.0);
+  m.number("gap_factor", out.gap_factor, false, 1.01, 1000.0);
+  m.number("rest_tolerance_mps2", out.rest_tolerance_mps2, false, 0.0, 100.0);
+}
+
+void read_imu_spec(YamlMap& m, ins::ImuSpec& s) {
+  // Each key: YAML unit -> SI factor.
+  const double dps = kDegToRad, dph = kDegToRad / 3600.0, mg = 1e-3 * kG0;
+  auto scaled = [&](const char* key, double& field, double factor) {
+    double v = field / factor;
+    m.number(key, v, false, 0.0, 1e12);
+    field = v * factor;
+  };
+  scaled("gyro_arw_deg_per_sqrt_hr", s.gyro_arw, kDegToRad / 60.0);
+  scaled("accel_vrw_mps_per_sqrt_hr", s.accel_vrw, 1.0 / 60.0);
+  scaled("gyro_bias_instability_deg_per_hr", s.gyro_bias_instability, dph);
+  scaled("gyro_bias_tau_s", s.gyro_bias_tau_s, 1.0);
+  scaled("gyro_bias_rw_deg_per_hr_per_sqrt_hr", s.gyro_bias_rw, dph / 60.0);
+  scaled("gyro_bias_initial_deg_per_s", s.gyro_bias_initial, dps);
+  scaled("accel_bias_instability_mg", s.accel_bias_instability, mg);
+  scaled("accel_bias_tau_s", s.accel_bias_tau_s, 1.0);
+  scaled("accel_bias_rw_mps2_per_sqrt_s", s.accel_bias_rw, 1.0);
+  scaled("accel_bias_initial_mg", s.accel_bias_initial, mg);
+  scaled("gyro_scale_ppm", s.gyro_scale_sigma, 1e-6);
+  scaled("accel_scale_ppm", s.accel_scale_sigma, 1e-6);
+  scaled("scale_tau_s", s.scale_tau_s, 1.0);
+  scaled("gyro_range_deg_per_s", s.gyro_range, dps);
+  scaled("accel_range_g", s.accel_range, kG0);
+  if (s.gyro_bias_instability > 0 && !(s.gyro_bias_tau_s > 0))
+    m.problem("gyro_bias_tau_s", "must be > 0 when gyro_bias_instability_deg_per_hr is given");
+  if (s.accel_bias_instability > 0 && !(s.accel_bias_tau_s > 0))
+    m.problem("accel_bias_tau_s", "must be > 0 when accel_bias_instability_mg is given");
+}
+
+Expected<ImuFormat> imu_format_preset(const std::string& name) {
+  const std::string text = imu_format_preset_yaml(name);
+  if (text.empty())
+    return make_error("unknown IMU format preset '" + name + "' (expected one of " +
+                      joined_names(imu_format_preset_names()) + ")");
+  auto problems = std::make_shared<YamlProblems>();
+  problems->file = "datasets/imu_formats/" + name + ".yaml";
+  ImuFormat f;
+  f.name = name;
+  {
+    YamlMap m(YAML::Load(text), "", problems, ".");
+    read_imu_format(m, f);
+  }
+  if (!problems->empty()) return make_error(problems->joined());
+  return f;
+}
 
 void read_imu_section(YamlMap& top, ImuConfig& out) {
   if (!top.has("imu")) return;
   YamlMap imu = top.map("imu");
   imu.path("file", out.file, true);
-  imu.text("format", out.format_preset);
-  imu.text("spec", out.spec_preset);
+  if (imu.has("format")) {
+    out.has_format = true;
+    const YAML::Node n = imu.raw("format");
+    if (n.IsScalar()) {
+      imu.text("format", out.format_preset);
+      auto f = imu_format_preset(out.format_preset);
+      if (f) {
+        out.format = *f;
+      } else {
+        imu.problem("format", f.error().message);
+      }
+    } else {
+      YamlMap m = imu.map("format");
+      out.format.name = "inline";
+      read_imu_format(m, out.format);
+    }
+  }
+  if (imu.has("spec")) {
+    out.has_spec = true;
+    const YAML::Node n = imu.raw("spec");
+    if (n.IsScalar()) {
+      imu.text("spec", out.spec_preset);
+      auto s = ins::imu_spec_preset(out.spec_preset);
+      if (s) {
+        out.spec = *s;
+      } else {
+        imu.problem("spec", s.error().message);
+      }
+    } else {
+      YamlMap m = imu.map("spec");
+      std::string base;
+      m.text("preset", base);
+      if (!base.empty()) {
+        auto s = ins::imu_spec_preset(base);
+        if (s) {
+          out.spec = *s;
+          out.spec_preset = base;
+        } else {
+          m.problem("preset", s.error().message);
+        }
+      }
+      out.spec.name = base.empty() ? "inline" : base + "+inline";
+      read_imu_spec(m, out.spec);
+    }
+  }
 }
 
 }  // namespace pednav::io
