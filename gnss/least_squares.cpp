@@ -60,9 +60,10 @@ int system_index(std::vector<System>& systems, System s) {
 }
 
 double code_sigma(const Candidate& c, const SolverOptions& o, bool sd) {
-  const double sr = measurement_sigma(o.weights, c.cn0_rover, c.elevation, false);
+  const double f = c.sat.system == System::kGlonass ? o.weights.glonass_code_factor : 1.0;
+  const double sr = f * measurement_sigma(o.weights, c.cn0_rover, c.elevation, false);
   if (!sd) return sr;
-  const double sb = measurement_sigma(o.weights, c.cn0_base, c.elevation_base, false);
+  const double sb = f * measurement_sigma(o.weights, c.cn0_base, c.elevation_base, false);
   return std::sqrt(sr * sr + sb * sb);
 }
 

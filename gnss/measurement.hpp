@@ -89,6 +89,7 @@ struct WeightModel {
   double doppler_sigma_zenith_mps = 0.05;///< range-rate noise at zenith and C/N0 >= cn0_ref [m/s]
   double cn0_ref_dbhz = 45.0;            ///< C/N0 above which noise no longer decreases [dB-Hz]
   double min_elevation_for_weight_rad = 5.0 * kDegToRad;  ///< 1/sin(el) is capped at this elevation
+  double glonass_code_factor = 3.0;      ///< GLONASS code sigma / GPS (x2 chip length, x1.5 FDMA biases)
 };
 /// Standard deviation [m or m/s] of one receiver's code (doppler=false) or range rate (doppler=true).
 double measurement_sigma(const WeightModel& model, double cn0_dbhz, double elevation_rad, bool doppler);

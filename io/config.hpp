@@ -34,6 +34,7 @@ struct GnssConfig {
   double code_sigma_zenith_m = 0.4;      ///< code noise at zenith and C/N0 >= cn0_ref_dbhz [m] (docs/gnss.md)
   double doppler_sigma_zenith_mps = 0.05;///< range-rate noise at zenith and C/N0 >= cn0_ref_dbhz [m/s]
   double cn0_ref_dbhz = 45.0;            ///< C/N0 above which the noise no longer decreases [dB-Hz]
+  double glonass_code_factor = 3.0;      ///< GLONASS code sigma / GPS code sigma (docs/gnss.md)
 };
 
 /// `imu:` section.

@@ -34,6 +34,7 @@ void read_gnss_section(YamlMap& top, GnssConfig& out) {
   g.number("code_sigma_zenith_m", out.code_sigma_zenith_m, false, 0.001, 100.0);
   g.number("doppler_sigma_zenith_mps", out.doppler_sigma_zenith_mps, false, 0.0001, 10.0);
   g.number("cn0_ref_dbhz", out.cn0_ref_dbhz, false, 10.0, 70.0);
+  g.number("glonass_code_factor", out.glonass_code_factor, false, 0.1, 100.0);
 }
 
 }  // namespace pednav::io

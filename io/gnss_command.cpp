@@ -170,6 +170,7 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
   opt.weights.code_sigma_zenith_m = g.code_sigma_zenith_m;
   opt.weights.doppler_sigma_zenith_mps = g.doppler_sigma_zenith_mps;
   opt.weights.cn0_ref_dbhz = g.cn0_ref_dbhz;
+  opt.weights.glonass_code_factor = g.glonass_code_factor;
 
   std::vector<SolutionRow> rows;
   rows.reserve(rover->epochs.size());

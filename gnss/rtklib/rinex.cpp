@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdarg>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 
@@ -83,6 +84,43 @@ Expected<void> check_readable(const std::string& path) {
   return {};
 }
 
+// Cheap pre-scan of a RINEX 3 observation body (RTKLIB silently skips event records and stops at a truncated
+// record): counts epoch flags 1 and 2-5 and detects a last epoch record with fewer satellite lines than announced.
+// RINEX 2 files are not scanned (their epoch lines cannot be told from data lines without decoding).
+void prescan_rinex3(const std::string& path, ObsReadStats& stats) {
+  std::FILE* f = std::fopen(path.c_str(), "r");
+  if (!f) return;
+  char buf[1024];
+  bool header = true;
+  int expected_lines = 0;  // satellite/header lines still due for the current record
+  bool in_record = false;
+  while (std::fgets(buf, sizeof buf, f)) {
+    const std::string line(buf);
+    if (header) {
+      if (line.find("RINEX VERSION / TYPE") != std::string::npos && line.size() > 5 && line.find_first_not_of(' ') < 9 &&
+          std::atof(line.substr(0, 9).c_str()) < 3.0) {
+        std::fclose(f);
+        return;
+      }
+      if (line.find("END OF HEADER") != std::string::npos) header = false;
+      continue;
+    }
+    if (expected_lines > 0) {
+      --expected_lines;
+      continue;
+    }
+    if (line.empty() || line[0] != '>' || line.size() < 35) continue;
+    const int flag = line[31] - '0';
+    const int n = std::atoi(line.substr(32, 3).c_str());
+    if (flag >= 2 && flag <= 5) ++stats.event_records;
+    if (flag == 1) ++stats.power_failure_epochs;
+    expected_lines = n;
+    in_record = true;
+  }
+  stats.truncated = in_record && expected_lines > 0;
+  std::fclose(f);
+}
+
 }  // namespace
 
 Expected<ObsData> read_rinex_obs(const std::string& path, const SystemSelection& systems) {
@@ -131,6 +169,7 @@ Expected<ObsData> read_rinex_obs(const std::string& path, const SystemSelection&
     out.epochs.back().sats.push_back(so);
   }
   out.stats.epochs_read = static_cast<int>(out.epochs.size());
+  prescan_rinex3(path, out.stats);
   return out;
 }
 

@@ -1,0 +1,122 @@
+// SD/UD pseudorange and range-rate Jacobians against central differences; weighting; chi-square quantiles.
+#include <gtest/gtest.h>
+
+#include "gnss/least_squares.hpp"
+#include "gnss/measurement.hpp"
+#include "tests/support/numdiff.hpp"
+
+namespace pednav::gnss {
+namespace {
+
+constexpr double kTolJacobian = 1e-6;  // dimensionless (m/m, (m/s)/(m/s)) and 1/s
+constexpr double kStepPos_m = 1.0;
+constexpr double kStepVel_mps = 0.1;
+
+SignalAtReceiver signal(const Eigen::Vector3d& p, const Eigen::Vector3d& v) {
+  SignalAtReceiver s;
+  s.sat.p_es_e = p;
+  s.sat.v_es_e = v;
+  s.sat.clock_bias_s = 1e-4;
+  s.sat.clock_drift_sps = 1e-11;
+  s.pseudorange_m = 2.2e7;
+  s.range_rate_mps = -400.0;
+  return s;
+}
+
+const Eigen::Vector3d kRover(3774083.0, -601659.0, 5089316.0), kBase(3774085.6, -601662.6, 5089316.4);
+const SignalAtReceiver kRoverSig = signal({1.5e7, -1.2e7, 1.8e7}, {1200.0, 2500.0, -800.0});
+const SignalAtReceiver kBaseSig = signal({1.5e7 + 3.0, -1.2e7 + 1.0, 1.8e7 - 2.0}, {1200.0, 2500.0, -800.0});
+const SatId kSat{System::kGps, 5};
+
+TEST(Measurement, SdPseudorangeJacobian) {
+  const MeasurementRow r = sd_pseudorange(kSat, kRoverSig, kBaseSig, kRover, kBase, 100.0);
+  auto f = [](const Eigen::VectorXd& x) {
+    Eigen::VectorXd out(1);
+    out(0) = -sd_pseudorange(kSat, kRoverSig, kBaseSig, x.head<3>(), kBase, x(3)).residual;  // prediction up to const
+    return out;
+  };
+  Eigen::VectorXd x(4);
+  x << kRover, 100.0;
+  const Eigen::MatrixXd J = test::numerical_jacobian(f, x, kStepPos_m);
+  EXPECT_LT((J.block<1, 3>(0, 0) - r.J_p).norm(), kTolJacobian);
+  EXPECT_NEAR(J(0, 3), r.J_clock, kTolJacobian);
+}
+
+TEST(Measurement, SdRangeRateJacobian) {
+  const Eigen::Vector3d v(0.8, -0.3, 0.1);
+  const MeasurementRow r = sd_range_rate(kSat, kRoverSig, kBaseSig, kRover, v, kBase, 2.0);
+  auto f = [](const Eigen::VectorXd& x) {
+    Eigen::VectorXd out(1);
+    out(0) = -sd_range_rate(kSat, kRoverSig, kBaseSig, x.head<3>(), x.segment<3>(3), kBase, x(6)).residual;
+    return out;
+  };
+  Eigen::VectorXd x(7);
+  x << kRover, v, 2.0;
+  const Eigen::MatrixXd Jp = test::numerical_jacobian(f, x, kStepPos_m);
+  const Eigen::MatrixXd Jv = test::numerical_jacobian(f, x, kStepVel_mps);
+  EXPECT_LT((Jp.block<1, 3>(0, 0) - r.J_p).norm(), 1e-9);  // 1/s
+  EXPECT_GT(r.J_p.norm(), 1e-5);                           // the geometry term is not negligible
+  EXPECT_LT((Jv.block<1, 3>(0, 3) - r.J_v).norm(), kTolJacobian);
+  EXPECT_NEAR(Jv(0, 6), r.J_drift, kTolJacobian);
+}
+
+TEST(Measurement, UdJacobiansAndSigns) {
+  const MeasurementRow p = ud_pseudorange(kSat, kRoverSig, kRover, 50.0, 3.0, 2.5);
+  auto f = [](const Eigen::VectorXd& x) {
+    Eigen::VectorXd out(1);
+    out(0) = -ud_pseudorange(kSat, kRoverSig, x.head<3>(), x(3), 3.0, 2.5).residual;
+    return out;
+  };
+  Eigen::VectorXd x(4);
+  x << kRover, 50.0;
+  const Eigen::MatrixXd J = test::numerical_jacobian(f, x, kStepPos_m);
+  EXPECT_LT((J.block<1, 3>(0, 0) - p.J_p).norm(), kTolJacobian);
+  EXPECT_NEAR(J(0, 3), p.J_clock, kTolJacobian);
+  // Moving towards the satellite shortens the range: J_p ~ -u.
+  const Eigen::Vector3d u = (kRoverSig.sat.p_es_e - kRover).normalized();
+  EXPECT_LT((p.J_p.transpose() + u).norm(), 1e-4);
+  const Eigen::Vector3d v(0.5, 0.5, 0.0);
+  const MeasurementRow d = ud_range_rate(kSat, kRoverSig, kRover, v, 1.0);
+  auto g = [&v](const Eigen::VectorXd& y) {
+    Eigen::VectorXd out(1);
+    out(0) = -ud_range_rate(kSat, kRoverSig, y.head<3>(), v, 1.0).residual;
+    return out;
+  };
+  const Eigen::MatrixXd Jd = test::numerical_jacobian(g, kRover, kStepPos_m);
+  EXPECT_LT((Jd - d.J_p).norm(), 1e-9);
+}
+
+TEST(Measurement, WeightsFollowCn0AndElevation) {
+  WeightModel m;
+  const double open = measurement_sigma(m, 45.0, kPi / 2, false);
+  EXPECT_NEAR(open, m.code_sigma_zenith_m, 1e-12);
+  EXPECT_NEAR(measurement_sigma(m, 25.0, kPi / 2, false), 10.0 * open, 1e-9);  // 20 dB weaker -> 10x sigma
+  EXPECT_NEAR(measurement_sigma(m, 45.0, 30.0 * kDegToRad, false), 2.0 * open, 1e-9);
+}
+
+TEST(Measurement, ChiSquareQuantiles) {
+  EXPECT_NEAR(chi_square_quantile(0.999, 1), 10.828, 1e-3);
+  EXPECT_NEAR(chi_square_quantile(0.95, 5), 11.070, 1e-3);
+  EXPECT_NEAR(chi_square_quantile(0.99, 20), 37.566, 1e-3);
+}
+
+TEST(Measurement, ElevationAzimuthOfZenithAndNorth) {
+  const Geodetic llh{0.9, -0.15, 50.0};
+  const Eigen::Vector3d p = ecef_from_geodetic(llh);
+  const Eigen::Vector3d up = ecef_from_geodetic({0.9, -0.15, 2.0e7});
+  EXPECT_NEAR(elevation_azimuth(p, up).elevation, kPi / 2, 1e-6);
+  const Eigen::Vector3d north = ecef_from_ned(Eigen::Vector3d(1000.0, 0.0, 0.0), p);
+  EXPECT_NEAR(elevation_azimuth(p, north).azimuth, 0.0, 1e-3);
+}
+
+TEST(Measurement, AtmosphereMagnitudes) {
+  const Geodetic llh{53.28 * kDegToRad, -9.06 * kDegToRad, 60.0};
+  EXPECT_NEAR(saastamoinen_delay_m(llh, kPi / 2), 2.4, 0.15);  // zenith total delay near sea level
+  const std::array<double, 8> ab{1.1176e-8, 7.4506e-9, -5.9605e-8, -5.9605e-8, 90112, 0, -196608, -65536};
+  const double iono = klobuchar_delay_m(ab, GpsTime::from_week_tow(2021, 401620.0), llh, {kPi / 2, 0.0});
+  EXPECT_GT(iono, 0.5);
+  EXPECT_LT(iono, 10.0);
+}
+
+}  // namespace
+}  // namespace pednav::gnss
