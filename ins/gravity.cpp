@@ -16,7 +16,7 @@ Eigen::Vector3d gravitation_ecef(const Eigen::Vector3d& p_e) {
                                   (1.0 + k * (3.0 - 5.0 * zr2)) * p_e.z());
 }
 
-// Groves 2013 eq. 2.133: g = γ - Ω_ie Ω_ie r  (Ω_ie = [ω_ie×], ω_ie = (0, 0, ω)).
+// Groves 2013 §2.4.7: g = γ - Ω_ie Ω_ie r  (Ω_ie = [ω_ie×], ω_ie = (0, 0, ω)).
 Eigen::Vector3d gravity_ecef(const Eigen::Vector3d& p_e) {
   constexpr double w2 = wgs84::kOmegaIE_radps * wgs84::kOmegaIE_radps;
   return gravitation_ecef(p_e) + Eigen::Vector3d(w2 * p_e.x(), w2 * p_e.y(), 0.0);
