@@ -13,5 +13,7 @@ void add_config_check_command(CLI::App& app, Action& action);
 void add_rinex_info_command(CLI::App& app, Action& action);
 void add_compare_command(CLI::App& app, Action& action);
 void add_gnss_command(CLI::App& app, Action& action);
+void add_simulate_command(CLI::App& app, Action& action);
+void add_run_command(CLI::App& app, Action& action);
 
 }  // namespace pednav::apps

@@ -22,6 +22,8 @@ int main(int argc, char** argv) {
   pednav::apps::add_rinex_info_command(app, action);
   pednav::apps::add_compare_command(app, action);
   pednav::apps::add_gnss_command(app, action);
+  pednav::apps::add_simulate_command(app, action);
+  pednav::apps::add_run_command(app, action);
 
   try {
     app.parse(argc, argv);

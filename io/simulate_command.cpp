@@ -1,0 +1,149 @@
+// `pednav simulate` outputs (docs/sim.md §7): the simulator's data formatted and written atomically.
+#include "io/simulate_command.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <filesystem>
+
+#include "core/geodesy.hpp"
+#include "core/rotation.hpp"
+#include "io/atomic_file.hpp"
+#include "io/rinex_writer.hpp"
+
+namespace pednav::io {
+namespace {
+
+long truth_step(const sim::Simulation& s) {
+  return std::max(1L, std::lround(s.scenario.imu.rate_hz / s.scenario.truth_rate_hz));
+}
+
+std::string yaml_path(const std::string& p) {
+  std::string q = "'";
+  for (char c : p) q += c == '\'' ? std::string("''") : std::string(1, c);
+  return q + "'";
+}
+
+}  // namespace
+
+std::string format_truth_csv(const sim::Simulation& s) {
+  std::string out =
+      "gps_week,gps_tow_s,lat_deg,lon_deg,h_m,x_m,y_m,z_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg,"
+      "ant_x_m,ant_y_m,ant_z_m,stance,route_m\n";
+  const long step = truth_step(s);
+  out.reserve(static_cast<size_t>(s.truth.nav.size() / static_cast<size_t>(step) + 1) * 230);
+  fmt::memory_buffer buf;
+  for (size_t k = 0; k < s.truth.nav.size(); k += static_cast<size_t>(step)) {
+    const ins::NavState& x = s.truth.nav[k];
+    const Geodetic llh = geodetic_from_ecef(x.p_eb_e);
+    const Eigen::Matrix3d R_n_e = R_e_n(llh.lat, llh.lon).transpose();
+    const Eigen::Vector3d v_n = R_n_e * x.v_eb_e;
+    const Eigen::Vector3d rpy = euler_from_R_n_b(R_n_e * x.R_e_b()) * kRadToDeg;
+    const Eigen::Vector3d& a = s.antenna[k].p_e;
+    buf.clear();
+    fmt::format_to(std::back_inserter(buf),
+                   "{},{:.9f},{:.10f},{:.10f},{:.5f},{:.5f},{:.5f},{:.5f},{:.7f},{:.7f},{:.7f},{:.9f},{:.9f},{:.9f},"
+                   "{:.4f},{:.4f},{:.4f},{},{:.3f}\n",
+                   x.t.week(), x.t.tow_s(), llh.lat * kRadToDeg, llh.lon * kRadToDeg, llh.h_m, x.p_eb_e.x(), x.p_eb_e.y(),
+                   x.p_eb_e.z(), v_n.x(), v_n.y(), v_n.z(), rpy.x(), rpy.y(), rpy.z(), a.x(), a.y(), a.z(),
+                   static_cast<int>(s.truth.stance[k]), s.antenna[k].route_m);
+    out.append(buf.data(), buf.size());
+  }
+  return out;
+}
+
+std::string format_imu_csv(const sim::Simulation& s) {
+  std::string out = "gps_week,gps_tow_s,gyro_x_radps,gyro_y_radps,gyro_z_radps,accel_x_mps2,accel_y_mps2,accel_z_mps2\n";
+  out.reserve(s.imu.size() * 110 + 100);
+  fmt::memory_buffer buf;
+  for (const auto& m : s.imu) {
+    buf.clear();
+    fmt::format_to(std::back_inserter(buf), "{},{:.9f},{:.10f},{:.10f},{:.10f},{:.9f},{:.9f},{:.9f}\n", m.t.week(),
+                   m.t.tow_s(), m.omega_ib_b.x(), m.omega_ib_b.y(), m.omega_ib_b.z(), m.f_ib_b.x(), m.f_ib_b.y(),
+                   m.f_ib_b.z());
+    out.append(buf.data(), buf.size());
+  }
+  return out;
+}
+
+std::string format_run_config(const sim::Simulation& s, const ScenarioFile& f) {
+  const sim::Scenario& sc = s.scenario;
+  std::string y = fmt::format("# Written by pednav simulate from {} (seed {}). Paths are relative to this file.\n",
+                              f.source_file, sc.seed);
+  y += "# mode gnss until `pednav run` exists; set mode: tc for the tightly coupled filter.\n";
+  y += (s.has_gnss || f.real_gnss) ? "mode: gnss\n" : "mode: ins\n";
+  if (f.real_gnss) {
+    const RealGnssFiles& r = *f.real_gnss;
+    const auto abs = [](const std::string& p) { return std::filesystem::absolute(p).lexically_normal().string(); };
+    y += "rover_obs: " + yaml_path(abs(r.rover_obs)) + "\n";
+    if (!r.base_obs.empty()) y += "base_obs: " + yaml_path(abs(r.base_obs)) + "\n";
+    y += "nav: [";
+    for (size_t i = 0; i < r.nav.size(); ++i) y += (i ? ", " : "") + yaml_path(abs(r.nav[i]));
+    y += "]\n";
+    if (r.base_position_ecef_m) {
+      const auto& b = *r.base_position_ecef_m;
+      y += fmt::format("base_position_ecef_m: [{:.4f}, {:.4f}, {:.4f}]\n", b.x(), b.y(), b.z());
+    }
+  } else if (s.has_gnss) {
+    const Eigen::Vector3d& b = s.gnss.p_base_e;
+    y += "rover_obs: rover.obs\nbase_obs: base.obs\nnav: [nav.rnx]\n";
+    y += fmt::format("base_position_ecef_m: [{:.4f}, {:.4f}, {:.4f}]\n", b.x(), b.y(), b.z());
+    y += fmt::format("gnss:\n  elevation_mask_deg: {:g}\n", std::max(10.0, sc.gnss.elevation_mask_rad * kRadToDeg));
+  }
+  y += "imu:\n  file: imu.csv\n";
+  y += fmt::format(
+      "  format:\n    delimiter: \",\"\n    header_lines: 1\n    time: {{base: gps_sow, column: 1, unit: s, gps_week: {}}}\n"
+      "    gyro: {{columns: [2, 3, 4], unit: rad_per_s}}\n    accel: {{columns: [5, 6, 7], unit: mps2}}\n",
+      s.imu.front().t.week());
+  y += "  spec: " + f.imu_spec_preset + "\n";
+  y += fmt::format("mechanization_rate_hz: {:g}\n", 20.0);
+  if (f.real_gnss) {
+    y += "reference:\n  file: " + yaml_path(std::filesystem::absolute(f.real_gnss->reference_file).lexically_normal().string()) +
+         "\n  format: " + (f.real_gnss->reference_format.empty() ? "nmea" : f.real_gnss->reference_format) + "\n";
+  } else {
+    y += "reference:\n  file: truth.csv\n  format: csv\n";
+  }
+  return y;
+}
+
+Expected<SimulateSummary> run_simulate_command(const ScenarioFile& file, const std::string& out_dir) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto sim = sim::simulate(file.scenario);
+  if (!sim) return make_error(file.source_file + ": " + sim.error().message);
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) return make_error(out_dir + ": cannot create output folder: " + ec.message());
+  const std::filesystem::path dir(out_dir);
+  auto put = [&](const char* name, const std::string& text) { return write_file_atomic((dir / name).string(), text); };
+  if (auto r = put("truth.csv", format_truth_csv(*sim)); !r) return r.error();
+  if (auto r = put("imu.csv", format_imu_csv(*sim)); !r) return r.error();
+  SimulateSummary sum;
+  if (sim->has_gnss) {
+    RinexObsHeader h;
+    h.interval_s = 1.0 / sim->scenario.gnss.rate_hz;
+    if (auto r = write_rinex_obs((dir / "rover.obs").string(), sim->gnss.rover, h); !r) return r.error();
+    h.receiver_type = "PEDNAV SIM BASE";
+    if (auto r = write_rinex_obs((dir / "base.obs").string(), sim->gnss.base, h); !r) return r.error();
+    if (auto r = write_rinex_nav((dir / "nav.rnx").string(), sim->nav); !r) return r.error();
+    std::string b = "gps_week,gps_tow_s,receiver,sat,error_m,event\n";
+    for (const auto& x : sim->gnss.blunders)
+      b += fmt::format("{},{:.3f},rover,{},{:.3f},{}\n", x.t.week(), x.t.tow_s(), x.sat.to_string(), x.error_m, x.id);
+    if (auto r = put("blunders.csv", b); !r) return r.error();
+    sum.rover_epochs = static_cast<int>(sim->gnss.rover.epochs.size());
+    sum.base_epochs = static_cast<int>(sim->gnss.base.epochs.size());
+    sum.blunder_events = sim->gnss.blunder_events;
+  }
+  if (auto r = put("config.yaml", format_run_config(*sim, file)); !r) return r.error();
+  sum.duration_s = sim->plan.duration_s;
+  sum.distance_m = sim->plan.distance_m;
+  sum.strides = static_cast<int>(sim->plan.strides.size());
+  sum.imu_samples = static_cast<long>(sim->imu.size());
+  sum.truth_rows = static_cast<long>((sim->truth.nav.size() + static_cast<size_t>(truth_step(*sim)) - 1) /
+                                     static_cast<size_t>(truth_step(*sim)));
+  sum.saturated_samples = sim->imu_errors.saturated_samples;
+  for (const auto& m : sim->truth.imu) sum.max_gyro_radps = std::max(sum.max_gyro_radps, m.omega_ib_b.norm());
+  sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return sum;
+}
+
+}  // namespace pednav::io

@@ -1,0 +1,210 @@
+// GNSS observation simulation (docs/sim.md §6). For each epoch tag t (receiver time) and satellite s:
+//   t_rx = t - dt_r (GPST reception), antenna at t_rx, transmit time from the light time incl. the delays,
+//   P = rho + c dt_r - c (dt_s - TGD) + I + T + e_thermal + e_multipath (+ e_atm_sd + blunder at the rover)
+//   -lambda D = rho_dot + c d(dt_r)/dt - c d(dt_s)/dt + e_doppler
+// rho and rho_dot from gnss::line_of_sight (Sagnac included), satellite states from gnss::satellite_state on the
+// same ephemerides a reader of nav.rnx sees. I = 1.3 x Klobuchar, T = 1.05 x Saastamoinen (so undifferenced
+// processing keeps a model error); the rover gets an extra single-difference residual that grows with baseline.
+#include "sim/gnss_sim.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "core/geodesy.hpp"
+#include "gnss/ephemeris.hpp"
+#include "gnss/measurement.hpp"
+#include "sim/random.hpp"
+
+namespace pednav::sim {
+namespace {
+
+constexpr double kL1_hz = 1575.42e6;
+constexpr double kLambdaL1_m = kSpeedOfLight_mps / kL1_hz;
+constexpr double kChip_m = kSpeedOfLight_mps / 1.023e6;
+constexpr double kIonoTruthFactor = 1.3;
+constexpr double kTropoTruthFactor = 1.05;
+
+double normal_cdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
+
+// One receiver's per-satellite state.
+struct Channel {
+  bool tracked = false;
+  double cn0_offset_db = 0.0;
+  UnitGaussMarkov multipath, attenuation, atmosphere;
+  double blunder_m = 0.0;
+  GpsTime blunder_until;
+  int blunder_id = 0;
+};
+
+struct Receiver {
+  const GnssOptions& o;
+  bool is_rover;
+  Rng rng;
+  std::map<int, Channel> ch;
+  Receiver(const GnssOptions& opt, bool rover, uint64_t seed)
+      : o(opt), is_rover(rover), rng(seed, rover ? kStreamRover : kStreamBase) {}
+  Channel& channel(int prn) {
+    auto it = ch.find(prn);
+    if (it != ch.end()) return it->second;
+    Channel c;
+    c.cn0_offset_db = o.cn0_satellite_sd_db * rng.normal();
+    c.multipath = UnitGaussMarkov(o.multipath_tau_s, rng);
+    c.attenuation = UnitGaussMarkov(1.0, rng);
+    c.atmosphere = UnitGaussMarkov(o.atmosphere_tau_s, rng);
+    return ch.emplace(prn, c).first->second;
+  }
+};
+
+// Attenuation [dB] at route distance route_m for a channel whose GM value is u (+inf: indoor).
+double attenuation_db(const GnssOptions& o, double route_m, double u) {
+  for (const auto& seg : o.attenuation) {
+    if (route_m < seg.from_m || route_m >= seg.to_m) continue;
+    if (seg.type == "indoor") return INFINITY;
+    if (seg.type == "foliage") return seg.min_db + (seg.max_db - seg.min_db) * normal_cdf(u);
+    return 0.0;
+  }
+  return 0.0;
+}
+double attenuation_tau_s(const GnssOptions& o, double route_m) {
+  for (const auto& seg : o.attenuation)
+    if (route_m >= seg.from_m && route_m < seg.to_m) return seg.tau_s;
+  return 10.0;
+}
+
+}  // namespace
+
+double thermal_code_sigma_m(const GnssOptions& o, double cn0_dbhz) {
+  const double cn0 = std::pow(10.0, cn0_dbhz / 10.0), d = o.correlator_spacing_chips;
+  return kChip_m * std::sqrt(o.dll_bandwidth_hz * d / (2.0 * cn0) * (1.0 + 2.0 / ((2.0 - d) * o.integration_time_s * cn0)));
+}
+double multipath_sigma_m(const GnssOptions& o, double cn0_dbhz) {
+  return o.multipath_sigma_m * std::pow(10.0, std::max(0.0, o.multipath_cn0_ref_dbhz - cn0_dbhz) / 20.0);
+}
+double doppler_sigma_mps(const GnssOptions& o, double cn0_dbhz) {
+  return o.doppler_sigma_mps * std::pow(10.0, std::max(0.0, o.multipath_cn0_ref_dbhz - cn0_dbhz) / 20.0);
+}
+
+GnssSimulation simulate_gnss(const GnssOptions& o, const gnss::NavData& nav, const AntennaFunction& rover_antenna,
+                             const Eigen::Vector3d& p_base_e, GpsTime t_begin, GpsTime t_end, uint64_t seed) {
+  GnssSimulation out;
+  out.p_base_e = p_base_e;
+  Receiver rx_rover(o, true, seed), rx_base(o, false, seed);
+  Rng clock_rng(seed, kStreamClocks), blunder_rng(seed, kStreamBlunders);
+  std::vector<int> prns;
+  for (const auto& e : nav.kepler)
+    if (std::find(prns.begin(), prns.end(), e.sat.prn) == prns.end()) prns.push_back(e.sat.prn);
+  std::sort(prns.begin(), prns.end());
+
+  const int64_t step_ns = std::llround(1e9 / o.rate_hz);
+  const double dt = static_cast<double>(step_ns) * 1e-9;
+  int64_t k0 = t_begin.ns() / step_ns;
+  if (k0 * step_ns < t_begin.ns()) ++k0;
+  ClockOptions cr = o.rover_clock, cb = o.base_clock;
+  const AntennaFunction base_antenna = [&](GpsTime) { return AntennaTruth{p_base_e, Eigen::Vector3d::Zero(), 0.0}; };
+
+  for (int64_t k = k0; k * step_ns <= t_end.ns(); ++k) {
+    const GpsTime tag = GpsTime::from_ns(k * step_ns);
+    if (k > k0) {  // two-state clocks: bias integrates drift, drift random-walks
+      cr.bias_s += cr.drift * dt;
+      cr.drift += cr.drift_rw * std::sqrt(dt) * clock_rng.normal();
+      cb.bias_s += cb.drift * dt;
+      cb.drift += cb.drift_rw * std::sqrt(dt) * clock_rng.normal();
+    }
+    out.clocks.push_back({tag, cr.bias_s, cr.drift, cb.bias_s, cb.drift});
+    for (int r = 0; r < 2; ++r) {
+      const bool is_rover = r == 0;
+      Receiver& rx = is_rover ? rx_rover : rx_base;
+      const ClockOptions& clk = is_rover ? cr : cb;
+      const GpsTime t_rx = tag.plus_s(-clk.bias_s);
+      const AntennaTruth ant = (is_rover ? rover_antenna : base_antenna)(t_rx);
+      const Geodetic llh = geodetic_from_ecef(ant.p_e);
+      const double baseline_m = (ant.p_e - p_base_e).norm();
+      gnss::ObsEpoch epoch;
+      epoch.time = tag;
+      for (const int prn : prns) {
+        const gnss::SatId sat{gnss::System::kGps, prn};
+        Channel& c = rx.channel(prn);
+        // Geometry: iterate the transmit time (flight time incl. atmospheric delays).
+        double flight_s = 0.075, iono = 0.0, tropo = 0.0;
+        gnss::SatState ss;
+        gnss::LineOfSight los;
+        gnss::ElevationAzimuth ea;
+        bool ok = true;
+        for (int it = 0; it < 3 && ok; ++it) {
+          auto st = gnss::satellite_state(nav, sat, t_rx.plus_s(-flight_s));
+          if (!st) {
+            ok = false;
+            break;
+          }
+          ss = *st;
+          los = gnss::line_of_sight(ss, ant.p_e, ant.v_e);
+          ea = gnss::elevation_azimuth(ant.p_e, ss.p_es_e);
+          if (ea.elevation > 0.0) {
+            iono = kIonoTruthFactor * gnss::klobuchar_delay_m(nav.klobuchar, t_rx, llh, ea);
+            tropo = kTropoTruthFactor * gnss::saastamoinen_delay_m(llh, ea.elevation);
+          }
+          flight_s = (los.range_m + iono + tropo) / kSpeedOfLight_mps;
+        }
+        // Correlated processes advance every epoch, visible or not (their statistics stay stationary).
+        c.multipath.step(dt, rx.rng);
+        c.atmosphere.step(dt, rx.rng);
+        const double u_att = c.attenuation.step(dt / std::max(1e-3, attenuation_tau_s(o, ant.route_m)), rx.rng);
+        const double cn0_noise = o.cn0_noise_db * rx.rng.normal();
+        const double w_thermal = rx.rng.normal(), w_doppler = rx.rng.normal();
+        if (!ok || ea.elevation < o.elevation_mask_rad) {
+          c.tracked = false;
+          continue;
+        }
+        const double sin_el = std::sin(ea.elevation);
+        const double att = is_rover ? attenuation_db(o, ant.route_m, u_att) : 0.0;
+        const double cn0_true = o.cn0_zenith_dbhz - (o.cn0_zenith_dbhz - o.cn0_horizon_dbhz) * (1.0 - sin_el) +
+                                c.cn0_offset_db - att;
+        const double cn0 = cn0_true + cn0_noise;
+        if (!std::isfinite(cn0)) {
+          c.tracked = false;
+          continue;
+        }
+        c.tracked = c.tracked ? cn0 >= o.tracking_threshold_dbhz : cn0 >= o.acquisition_threshold_dbhz;
+        if (!c.tracked) continue;
+        double P = los.range_m + kSpeedOfLight_mps * (clk.bias_s - (ss.clock_bias_s - ss.group_delay_s)) + iono + tropo +
+                   thermal_code_sigma_m(o, cn0_true) * w_thermal + multipath_sigma_m(o, cn0_true) * c.multipath.value();
+        if (is_rover) {
+          P += o.atmosphere_sd_ppm * 1e-6 * baseline_m / std::max(0.1, sin_el) * c.atmosphere.value();
+          ++out.rover_sat_epochs;
+          if (tag >= c.blunder_until && o.blunder_rate > 0.0 && blunder_rng.uniform() < o.blunder_rate) {
+            const double mag = blunder_rng.uniform(o.blunder_min_m, o.blunder_max_m);
+            c.blunder_m = blunder_rng.uniform() < 0.5 ? -mag : mag;
+            const double dur = blunder_rng.uniform(o.blunder_min_s, o.blunder_max_s);
+            c.blunder_until = tag.plus_s(std::max(dt, std::round(dur / dt) * dt) - 0.5 * dt);
+            c.blunder_id = ++out.blunder_events;
+          }
+          if (tag < c.blunder_until) {
+            P += c.blunder_m;
+            out.blunders.push_back({tag, sat, c.blunder_m, c.blunder_id});
+          }
+        }
+        const double rr = los.range_rate_mps + kSpeedOfLight_mps * (clk.drift - ss.clock_drift_sps) +
+                          doppler_sigma_mps(o, cn0_true) * w_doppler;
+        gnss::SatObs so;
+        so.sat = sat;
+        so.pseudorange_m = P;
+        so.doppler_hz = -rr / kLambdaL1_m;
+        so.cn0_dbhz = cn0;
+        so.wavelength_m = kLambdaL1_m;
+        epoch.sats.push_back(so);
+      }
+      if (!epoch.sats.empty()) (is_rover ? out.rover : out.base).epochs.push_back(std::move(epoch));
+    }
+  }
+  out.rover.approx_position_e = rover_antenna(t_begin).p_e;
+  out.rover.has_approx_position = true;
+  out.rover.marker_name = "ROVER";
+  out.base.approx_position_e = p_base_e;
+  out.base.has_approx_position = true;
+  out.base.marker_name = "BASE";
+  out.rover.rinex_version = out.base.rinex_version = 3.04;
+  return out;
+}
+
+}  // namespace pednav::sim

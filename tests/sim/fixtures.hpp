@@ -1,0 +1,102 @@
+// Shared scenario texts and helpers of the simulator tests.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "io/scenario_config.hpp"
+
+namespace pednav::test {
+
+/// A 10-minute noise-free walk: corridor legs, right-angle and U-turns, stairs (3 m up and down), a pause.
+inline const char* kNoiseFreeWalkYaml = R"(
+name: noise_free_walk
+seed: 11
+start: {gps_week: 2300, gps_tow_s: 100000}
+origin: {lat_deg: 47.3, lon_deg: 8.5, h_m: 500}
+route:
+  static_start_s: 10
+  static_end_s: 5
+  waypoints:
+    - {e_m: 0, n_m: 0}
+    - {e_m: 60, n_m: 0}
+    - {e_m: 60, n_m: 40, pause_s: 8}
+    - {e_m: 0, n_m: 40}
+    - {e_m: 0, n_m: 0}
+    - {e_m: 30, n_m: 0}
+    - {e_m: 36, n_m: 0, u_m: 3}
+    - {e_m: 60, n_m: 0, u_m: 3}
+    - {e_m: 66, n_m: 0, u_m: 0}
+    - {e_m: 120, n_m: 0}
+    - {e_m: 120, n_m: 80}
+    - {e_m: 20, n_m: 80}
+    - {e_m: 20, n_m: 10}
+    - {e_m: 100, n_m: 10}
+    - {e_m: 100, n_m: 60}
+    - {e_m: 40, n_m: 60}
+    - {e_m: 40, n_m: 20}
+    - {e_m: 80, n_m: 20}
+    - {e_m: 80, n_m: 70}
+    - {e_m: 10, n_m: 70}
+    - {e_m: 10, n_m: 5}
+    - {e_m: 110, n_m: 5}
+    - {e_m: 0, n_m: 5}
+gait: {speed_mps: 1.3, cycle_s: 1.1, stance_fraction: 0.3, pitch_rate_peak_radps: 7.0}
+imu: {rate_hz: 100, spec: crista, errors: false}
+gnss: {enabled: false}
+)";
+
+/// Parse a scenario text (fails the test on error).
+inline io::ScenarioFile scenario_from_text(const std::string& text) {
+  auto sc = io::parse_scenario(text, "test.yaml", ".");
+  EXPECT_TRUE(sc.has_value()) << (sc ? "" : sc.error().message);
+  return sc ? *sc : io::ScenarioFile{};
+}
+
+/// A fresh empty temporary folder.
+inline std::string temp_dir(const std::string& name) {
+  const auto p = std::filesystem::temp_directory_path() / ("pednav_test_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(p);
+  std::filesystem::create_directories(p);
+  return p.string();
+}
+
+inline std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// Rows of a simple numeric CSV with a header (non-numeric cells become NaN).
+inline std::vector<std::vector<double>> read_numeric_csv(const std::string& path, std::vector<std::string>* header) {
+  std::ifstream in(path);
+  std::string line;
+  std::vector<std::vector<double>> rows;
+  if (std::getline(in, line) && header) {
+    std::stringstream hs(line);
+    std::string c;
+    while (std::getline(hs, c, ',')) header->push_back(c);
+  }
+  while (std::getline(in, line)) {
+    std::vector<double> r;
+    std::stringstream ls(line);
+    std::string c;
+    while (std::getline(ls, c, ',')) {
+      char* end = nullptr;
+      const double v = std::strtod(c.c_str(), &end);
+      r.push_back(end != c.c_str() ? v : std::nan(""));
+    }
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+}  // namespace pednav::test
