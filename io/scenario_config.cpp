@@ -50,7 +50,7 @@ void read_gnss(YamlMap& g, sim::GnssOptions& o) {
   g.number("multipath_cn0_ref_dbhz", o.multipath_cn0_ref_dbhz, false, 0.0, 60.0);
   g.number("multipath_tau_s", o.multipath_tau_s, false, 0.01, 1e5);
   g.number("doppler_sigma_mps", o.doppler_sigma_mps, false, 0.0, 10.0);
-  g.number("atmosphere_sd_ppm", o.atmosphere_sd_ppm, false, 0.0, 100.0);
+  g.number("atmosphere_sd_ppm", o.atmosphere_sd_ppm, false, 0.0, 1000.0);
   g.number("atmosphere_tau_s", o.atmosphere_tau_s, false, 0.01, 1e6);
   {
     YamlMap c = g.map("rover_clock");

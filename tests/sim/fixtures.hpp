@@ -100,3 +100,34 @@ inline std::vector<std::vector<double>> read_numeric_csv(const std::string& path
 }
 
 }  // namespace pednav::test
+
+namespace pednav::test {
+
+/// A 15-minute open-sky walk with a constant C/N0 (45 dB-Hz on every satellite, no C/N0 noise) so the
+/// configured noise levels are known exactly; blunders off unless a test sets them.
+inline const char* kOpenSkyGnssYaml = R"(
+name: open_sky_gnss
+seed: 21
+start: {gps_week: 2300, gps_tow_s: 300000}
+origin: {lat_deg: -33.9, lon_deg: 151.2, h_m: 40}
+route:
+  static_start_s: 20
+  static_end_s: 10
+  shape: {type: rectangle, east_m: 120, north_m: 60, laps: 3}
+gait: {speed_mps: 1.2, cycle_s: 1.1}
+imu: {rate_hz: 100, spec: crista, errors: true}
+gnss:
+  base_offset_enu_m: [300, 400, 5]
+  cn0_zenith_dbhz: 45
+  cn0_horizon_dbhz: 45
+  cn0_satellite_sd_db: 0
+  cn0_noise_db: 0
+  multipath_sigma_m: 0.5
+  multipath_tau_s: 1.0
+  doppler_sigma_mps: 0.05
+  atmosphere_sd_ppm: 600
+  atmosphere_tau_s: 2.0
+output: {truth_rate_hz: 10}
+)";
+
+}  // namespace pednav::test
