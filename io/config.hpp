@@ -30,6 +30,7 @@ struct GnssConfig {
   double epoch_match_tolerance_s = 0.1;  ///< rover/base epochs closer than this are simultaneous
   double max_base_age_s = 30.0;          ///< older base epochs are not propagated
   double min_cn0_dbhz = 0.0;             ///< signals below are not used
+  bool use_doppler = true;               ///< Doppler updates in pednav run
   std::string base_propagation = "ephemeris";  ///< older base epochs: ephemeris (exact geometry) | doppler
   double code_sigma_zenith_m = 0.4;      ///< code noise at zenith and C/N0 >= cn0_ref_dbhz [m] (docs/gnss.md)
   double doppler_sigma_zenith_mps = 0.05;///< range-rate noise at zenith and C/N0 >= cn0_ref_dbhz [m/s]
@@ -56,8 +57,47 @@ struct ReferenceConfig {
 
 /// `zupt:` section.
 struct ZuptConfig {
-  std::string detector = "mv";  ///< mv (seed 004 eq. 1) | shoe | hmm
+  std::string detector = "shoe";  ///< shoe (Skog et al. 2010) | mv (seed 004 eq. 1) | hmm
   std::string form = "D";       ///< D (seed 001 eq. 8) | F (seed 001 eq. 9)
+  double mv_window_s = 0.05;              ///< key mv_window_s
+  double mv_threshold_mps2 = 0.6;         ///< key mv_threshold_mps2
+  double mv_gyro_threshold_radps = 1.5;   ///< key mv_gyro_threshold_deg_per_s
+  double min_time_since_step_s = 0.25;    ///< seed 004 eq. 1 Δt
+  double shoe_window_s = 0.03;
+  double shoe_sigma_accel_mps2 = 0.5;
+  double shoe_sigma_gyro_radps = 0.1;     ///< key shoe_sigma_gyro_deg_per_s
+  double shoe_threshold = 10.0;
+  double min_stance_s = 0.04;
+  double sigma_mps = 0.02;                ///< ZUPT measurement noise per axis
+  bool zaru = false;
+  double zaru_sigma_radps = 0.01;         ///< key zaru_sigma_deg_per_s
+};
+
+/// `initial:` section (pednav run).
+struct InitialConfig {
+  std::optional<double> yaw_rad;                 ///< key yaw_deg; absent: heading from motion (tc)
+  std::optional<Eigen::Vector3d> position_e;     ///< key position_ecef_m or lat_deg/lon_deg/h_m
+  double heading_init_distance_m = 30.0;
+  double sigma_position_m = 5.0;
+  double sigma_velocity_mps = 0.1;
+  double sigma_tilt_rad = 2.0 * 3.14159265358979323846 / 180.0;   ///< key sigma_tilt_deg
+  double sigma_yaw_rad = 10.0 * 3.14159265358979323846 / 180.0;   ///< key sigma_yaw_deg (configured heading)
+};
+
+/// `antenna:` section: IMU (foot) -> antenna (backpack) geometry of the tightly coupled filter.
+struct AntennaConfig {
+  Eigen::Vector3d lever_arm_ned_m{0.0, 0.0, -1.2};
+  double sigma_horizontal_m = 0.4;
+  double sigma_vertical_m = 0.2;
+  double velocity_sigma_horizontal_mps = 1.0;
+  double velocity_sigma_vertical_mps = 0.3;
+};
+
+/// `clock:` section: differential receiver clock model.
+struct ClockConfig {
+  double psd_m2_per_s = 1.0;
+  double drift_psd_m2_per_s3 = 0.1;
+  double jump_threshold_m = 300.0;
 };
 
 /// `output:` section.
@@ -75,6 +115,9 @@ struct RunConfig {
   ReferenceConfig reference;
   double mechanization_rate_hz = 20.0;
   ZuptConfig zupt;
+  InitialConfig initial;
+  AntennaConfig antenna;
+  ClockConfig clock;
   double fault_rejection_probability = 0.999;  ///< chi-square test probability of the innovation check
   bool smoother_enabled = true;
   OutputConfig output;

@@ -1,4 +1,5 @@
 // YAML section reader: filter options (mechanization rate, ZUPT, fault rejection, smoother).
+#include "core/geodesy.hpp"
 #include "io/config.hpp"
 #include "io/yaml_schema.hpp"
 
@@ -10,6 +11,71 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
     YamlMap z = top.map("zupt");
     z.choice("detector", out.zupt.detector, {"mv", "shoe", "hmm"});
     z.choice("form", out.zupt.form, {"D", "F"});
+    ZuptConfig& c = out.zupt;
+    z.number("mv_window_s", c.mv_window_s, false, 1e-3, 5.0);
+    z.number("mv_threshold_mps2", c.mv_threshold_mps2, false, 1e-6, 100.0);
+    double g = c.mv_gyro_threshold_radps * kRadToDeg;
+    z.number("mv_gyro_threshold_deg_per_s", g, false, 0.0, 5000.0);
+    c.mv_gyro_threshold_radps = g * kDegToRad;
+    z.number("min_time_since_step_s", c.min_time_since_step_s, false, 0.0, 5.0);
+    z.number("shoe_window_s", c.shoe_window_s, false, 1e-3, 5.0);
+    z.number("shoe_sigma_accel_mps2", c.shoe_sigma_accel_mps2, false, 1e-6, 100.0);
+    double sg = c.shoe_sigma_gyro_radps * kRadToDeg;
+    z.number("shoe_sigma_gyro_deg_per_s", sg, false, 1e-6, 1000.0);
+    c.shoe_sigma_gyro_radps = sg * kDegToRad;
+    z.number("shoe_threshold", c.shoe_threshold, false, 1e-9, 1e12);
+    z.number("min_stance_s", c.min_stance_s, false, 0.0, 5.0);
+    z.number("sigma_mps", c.sigma_mps, false, 1e-6, 10.0);
+    z.boolean("zaru", c.zaru);
+    double zs = c.zaru_sigma_radps * kRadToDeg;
+    z.number("zaru_sigma_deg_per_s", zs, false, 1e-9, 100.0);
+    c.zaru_sigma_radps = zs * kDegToRad;
+  }
+  {
+    YamlMap i = top.map("initial");
+    InitialConfig& c = out.initial;
+    if (i.has("yaw_deg")) {
+      double y = 0.0;
+      i.number("yaw_deg", y, false, -360.0, 360.0);
+      c.yaw_rad = y * kDegToRad;
+    }
+    if (i.has("position_ecef_m")) {
+      Eigen::Vector3d p = Eigen::Vector3d::Zero();
+      i.vector3("position_ecef_m", p);
+      c.position_e = p;
+    }
+    if (i.has("lat_deg") || i.has("lon_deg") || i.has("h_m")) {
+      Geodetic g0;
+      double lat = 0, lon = 0, h = 0;
+      i.number("lat_deg", lat, true, -90.0, 90.0);
+      i.number("lon_deg", lon, true, -180.0, 360.0);
+      i.number("h_m", h, true, -1000.0, 100000.0);
+      g0 = {lat * kDegToRad, lon * kDegToRad, h};
+      c.position_e = ecef_from_geodetic(g0);
+    }
+    i.number("heading_init_distance_m", c.heading_init_distance_m, false, 5.0, 10000.0);
+    i.number("sigma_position_m", c.sigma_position_m, false, 1e-4, 1e5);
+    i.number("sigma_velocity_mps", c.sigma_velocity_mps, false, 1e-5, 100.0);
+    double t = c.sigma_tilt_rad * kRadToDeg, y = c.sigma_yaw_rad * kRadToDeg;
+    i.number("sigma_tilt_deg", t, false, 1e-4, 90.0);
+    i.number("sigma_yaw_deg", y, false, 1e-4, 180.0);
+    c.sigma_tilt_rad = t * kDegToRad;
+    c.sigma_yaw_rad = y * kDegToRad;
+  }
+  {
+    YamlMap a = top.map("antenna");
+    AntennaConfig& c = out.antenna;
+    a.vector3("lever_arm_ned_m", c.lever_arm_ned_m);
+    a.number("sigma_horizontal_m", c.sigma_horizontal_m, false, 0.0, 100.0);
+    a.number("sigma_vertical_m", c.sigma_vertical_m, false, 0.0, 100.0);
+    a.number("velocity_sigma_horizontal_mps", c.velocity_sigma_horizontal_mps, false, 0.0, 100.0);
+    a.number("velocity_sigma_vertical_mps", c.velocity_sigma_vertical_mps, false, 0.0, 100.0);
+  }
+  {
+    YamlMap k = top.map("clock");
+    k.number("psd_m2_per_s", out.clock.psd_m2_per_s, false, 0.0, 1e12);
+    k.number("drift_psd_m2_per_s3", out.clock.drift_psd_m2_per_s3, false, 0.0, 1e12);
+    k.number("jump_threshold_m", out.clock.jump_threshold_m, false, 1.0, 1e9);
   }
   {
     YamlMap f = top.map("fault_rejection");

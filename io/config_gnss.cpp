@@ -30,6 +30,7 @@ void read_gnss_section(YamlMap& top, GnssConfig& out) {
   g.number("epoch_match_tolerance_s", out.epoch_match_tolerance_s, false, 0.0, 10.0);
   g.number("max_base_age_s", out.max_base_age_s, false, 0.0, 3600.0);
   g.number("min_cn0_dbhz", out.min_cn0_dbhz, false, 0.0, 70.0);
+  g.boolean("use_doppler", out.use_doppler);
   g.choice("base_propagation", out.base_propagation, {"ephemeris", "doppler"});
   g.number("code_sigma_zenith_m", out.code_sigma_zenith_m, false, 0.001, 100.0);
   g.number("doppler_sigma_zenith_mps", out.doppler_sigma_zenith_mps, false, 0.0001, 10.0);

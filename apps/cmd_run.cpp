@@ -1,0 +1,33 @@
+// `pednav run CONFIG.yaml -o OUT`.
+#include <spdlog/spdlog.h>
+
+#include "apps/commands.hpp"
+#include "io/config.hpp"
+#include "io/run_command.hpp"
+
+namespace pednav::apps {
+
+void add_run_command(CLI::App& app, Action& action) {
+  auto* cmd = app.add_subcommand("run", "Tightly coupled foot-IMU + GNSS filter (mode tc) or INS/ZUPT (mode ins)");
+  auto config = std::make_shared<std::string>();
+  auto out = std::make_shared<std::string>();
+  cmd->add_option("CONFIG", *config, "Run configuration (YAML)")->required();
+  cmd->add_option("-o,--out", *out, "Output folder")->required();
+  cmd->callback([&action, config, out] {
+    action = [config, out] {
+      auto cfg = io::load_run_config(*config);
+      if (!cfg) {
+        spdlog::error("{}", cfg.error().message);
+        return 1;
+      }
+      auto sum = io::run_run_command(*cfg, *out);
+      if (!sum) {
+        spdlog::error("{}", sum.error().message);
+        return 1;
+      }
+      return 0;
+    };
+  });
+}
+
+}  // namespace pednav::apps

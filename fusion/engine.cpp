@@ -1,0 +1,712 @@
+#include "fusion/engine.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "core/geodesy.hpp"
+#include "core/rotation.hpp"
+#include "gnss/ephemeris.hpp"
+#include "gnss/epoch_matching.hpp"
+#include "gnss/least_squares.hpp"
+#include "ins/alignment.hpp"
+#include "ins/mechanization.hpp"
+
+namespace pednav::fusion {
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+
+int system_slot(const std::vector<gnss::System>& systems, gnss::System s) {
+  for (size_t i = 0; i < systems.size(); ++i) {
+    if (systems[i] == s) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+// One candidate GNSS measurement row with its noise.
+struct Row {
+  gnss::SatId sat;
+  bool doppler = false;
+  double residual = 0.0;
+  Eigen::RowVectorXd h;
+  double sigma = 0.0;
+};
+
+// The filter state: nominal INS state + differential clocks, error covariance.
+class Filter {
+ public:
+  Filter(const EngineOptions& o, int n_clocks) : o_(o) {
+    if (o.mode == Mode::kTightlyCoupled) {
+      for (int i = 0; i < n_clocks; ++i) clock_blocks_.push_back(*layout_.add("clock_" + std::to_string(i), 1));
+      drift_block_ = *layout_.add("drift", 1);
+    }
+    clock_m_.assign(n_clocks, 0.0);
+  }
+
+  void init(const ins::NavState& nav, const ins::ImuErrors& imu) {
+    x_.nav = nav;
+    x_.imu = imu;
+    const double st = o_.initial_sigma_tilt_rad;
+    P_ = ins::initial_covariance(layout_, o_.spec, o_.initial_sigma_pos_m, o_.initial_sigma_vel_mps,
+                                 Vector3d(st, st, st));
+    // The attitude block is resolved in e: build it from NED sigmas (tilt, tilt, yaw).
+    const Geodetic llh = geodetic_from_ecef(nav.p_eb_e);
+    const Eigen::Matrix3d Ren = R_e_n(llh.lat, llh.lon);
+    const Eigen::Matrix3d att_n = Vector3d(st * st, st * st, o_.initial_sigma_yaw_rad * o_.initial_sigma_yaw_rad).asDiagonal();
+    P_.block<3, 3>(ins::kAtt.offset, ins::kAtt.offset) = Ren * att_n * Ren.transpose();
+    for (const auto& b : clock_blocks_) P_(b.offset, b.offset) = 1e12;  // unknown until the first GNSS epoch
+    if (o_.mode == Mode::kTightlyCoupled) P_(drift_block_.offset, drift_block_.offset) = 1e6;
+  }
+
+  // Mechanize one (already bias-corrected) increment and propagate the covariance.
+  void predict(const ins::ImuIncrement& inc) {
+    const ins::NavState after = ins::mechanize(x_.nav, inc);
+    ins::DiscreteErrorModel m = ins::interval_error_model(layout_, o_.spec, x_.nav, after, inc);
+    const double dt = inc.dt_s;
+    if (o_.mode == Mode::kTightlyCoupled) {
+      const int d = drift_block_.offset;
+      const double qc = o_.clock_psd_m2_per_s, qd = o_.drift_psd_m2_per_s3;
+      m.Qd(d, d) += qd * dt;
+      for (size_t i = 0; i < clock_blocks_.size(); ++i) {
+        const int c = clock_blocks_[i].offset;
+        m.Phi(c, d) = dt;  // clock += drift dt
+        m.Qd(c, c) += qc * dt + qd * dt * dt * dt / 3.0;
+        m.Qd(c, d) += qd * dt * dt / 2.0;
+        m.Qd(d, c) += qd * dt * dt / 2.0;
+        clock_m_[i] += drift_mps_ * dt;
+      }
+    }
+    P_ = m.Phi * P_ * m.Phi.transpose() + m.Qd;
+    P_ = 0.5 * (P_ + P_.transpose());
+    x_.nav = after;
+  }
+
+  // Joseph-form update with residuals r (measured - predicted), Jacobian H and noise covariance R;
+  // the correction is fed back into the nominal state (closed loop) and the error state reset to zero.
+  bool update(const VectorXd& r, const MatrixXd& H, const MatrixXd& R) {
+    const MatrixXd PHt = P_ * H.transpose();
+    const MatrixXd S = H * PHt + R;
+    Eigen::LDLT<MatrixXd> ldlt(S);
+    if (ldlt.info() != Eigen::Success) return false;
+    const MatrixXd K = ldlt.solve(PHt.transpose()).transpose();
+    const VectorXd dx = K * r;
+    const MatrixXd IKH = MatrixXd::Identity(P_.rows(), P_.cols()) - K * H;
+    P_ = IKH * P_ * IKH.transpose() + K * R * K.transpose();
+    P_ = 0.5 * (P_ + P_.transpose());
+    apply(dx);
+    return true;
+  }
+
+  void apply(const VectorXd& dx) {
+    x_ = ins::boxplus(x_, dx, layout_);
+    for (size_t i = 0; i < clock_blocks_.size(); ++i) clock_m_[i] += dx(clock_blocks_[i].offset);
+    if (o_.mode == Mode::kTightlyCoupled) drift_mps_ += dx(drift_block_.offset);
+  }
+
+  // Reset a clock to a new value with a large variance (receiver clock jump).
+  void reset_clock(int slot, double value_m, double sigma_m) {
+    const int c = clock_blocks_[slot].offset;
+    clock_m_[slot] = value_m;
+    P_.row(c).setZero();
+    P_.col(c).setZero();
+    P_(c, c) = sigma_m * sigma_m;
+  }
+  void reset_drift(double value_mps, double sigma_mps) {
+    const int d = drift_block_.offset;
+    drift_mps_ = value_mps;
+    P_.row(d).setZero();
+    P_.col(d).setZero();
+    P_(d, d) = sigma_mps * sigma_mps;
+  }
+
+  bool healthy(std::string& why) const {
+    if (!P_.allFinite() || !x_.nav.p_eb_e.allFinite() || !x_.nav.v_eb_e.allFinite()) {
+      why = "non-finite state or covariance";
+      return false;
+    }
+    for (int i = 0; i < P_.rows(); ++i) {
+      if (P_(i, i) <= 0.0) {
+        why = "non-positive variance of state " + std::to_string(i);
+        return false;
+      }
+    }
+    return true;
+  }
+
+  const ins::ErrorStateLayout& layout() const { return layout_; }
+  ins::InsState& x() { return x_; }
+  const MatrixXd& P() const { return P_; }
+  double clock(int slot) const { return clock_m_[slot]; }
+  double drift() const { return drift_mps_; }
+  int clock_offset(int slot) const { return clock_blocks_[slot].offset; }
+  int drift_offset() const { return drift_block_.offset; }
+
+ private:
+  const EngineOptions& o_;
+  ins::ErrorStateLayout layout_;
+  std::vector<ins::Block> clock_blocks_;
+  ins::Block drift_block_{0, 0};
+  ins::InsState x_;
+  MatrixXd P_;
+  std::vector<double> clock_m_;
+  double drift_mps_ = 0.0;
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+struct PassOptions {
+  bool gnss = true;
+  std::optional<GpsTime> stop;
+};
+
+class Runner {
+ public:
+  Runner(const EngineInputs& in, const EngineOptions& o, const std::vector<ins::ZuptDecision>& decisions)
+      : in_(in), o_(o), decisions_(decisions) {
+    if (o.mode == Mode::kTightlyCoupled && in.rover && in.base && o.base_position_e) {
+      std::vector<GpsTime> rt, bt;
+      for (const auto& e : *in.rover) rt.push_back(e.time);
+      for (const auto& e : *in.base) bt.push_back(e.time);
+      matches_ = gnss::match_base_epochs(rt, bt, o.max_base_age_s);
+      sd_ = true;
+    }
+  }
+
+  Vector3d lever_e(const Vector3d& p_e) const {
+    const Geodetic llh = geodetic_from_ecef(p_e);
+    return R_e_n(llh.lat, llh.lon) * o_.lever_arm_n_m;
+  }
+
+  // Epoch LSQ antenna position (used for initialization and the heading fit).
+  std::optional<Vector3d> lsq_position(size_t rover_index, const Vector3d& p_init) const {
+    if (!in_.nav || !in_.rover) return std::nullopt;
+    const gnss::ObsEpoch& re = (*in_.rover)[rover_index];
+    const gnss::ObsEpoch* be = nullptr;
+    if (sd_) {
+      if (matches_[rover_index].base_index < 0) return std::nullopt;
+      be = &(*in_.base)[matches_[rover_index].base_index];
+    }
+    gnss::SolverOptions so;
+    so.elevation_mask_rad = o_.elevation_mask_rad;
+    so.min_cn0_dbhz = o_.min_cn0_dbhz;
+    so.weights = o_.weights;
+    so.fault_probability = o_.fault_probability;
+    gnss::ObsEpoch filtered = re;
+    std::erase_if(filtered.sats, [&](const gnss::SatObs& s) { return system_slot(o_.systems, s.sat.system) < 0; });
+    if (in_.gnss_mask) in_.gnss_mask(filtered);
+    const auto sol = gnss::solve_epoch(*in_.nav, filtered, be, o_.base_position_e.value_or(Vector3d::Zero()), p_init, so);
+    if (!sol.ok()) return std::nullopt;
+    return sol.p_ea_e;
+  }
+
+  // Run the filter from sample `start` with the given initial state; fills result (outputs + summary).
+  Expected<void> run(size_t start, const ins::NavState& nav0, const ins::ImuErrors& imu0, const PassOptions& po,
+                     EngineResult& result) {
+    const auto& samples = *in_.imu;
+    Filter f(o_, static_cast<int>(o_.systems.size()));
+    f.init(nav0, imu0);
+    EngineSummary& sum = result.summary;
+    ins::IncrementOptions io;
+    io.rate_hz = o_.mechanization_rate_hz;
+    ins::IncrementIntegrator integrator(io);
+    const int64_t out_period_ns = static_cast<int64_t>(std::llround(1e9 / o_.output_rate_hz));
+    int64_t next_out_ns = ((nav0.t.ns() + out_period_ns - 1) / out_period_ns) * out_period_ns;
+    size_t gi = 0;
+    bool clock_initialized = false;
+    if (in_.rover) {
+      while (gi < in_.rover->size() && (*in_.rover)[gi].time < nav0.t) {
+        ++gi;
+        ++sum.gnss_epochs_before_start;
+      }
+    }
+    size_t sample_index = start;
+    int last_used = 0, last_rejected = 0;
+    bool failed = false;
+    std::string fail_message;
+
+    auto on_increment = [&](const ins::ImuIncrement& inc) {
+      if (failed) return;
+      f.predict(inc);
+      ++sum.mechanization_steps;
+      // ZUPT (+ ZARU) when the detector flags the sample at the interval end as stance.
+      const bool stance = decisions_[std::min(sample_index, decisions_.size() - 1)].stance;
+      if (stance) {
+        zupt_update(f, inc);
+        ++sum.zupt_updates;
+      }
+      // GNSS epochs up to the interval end.
+      while (po.gnss && o_.mode == Mode::kTightlyCoupled && in_.rover && gi < in_.rover->size() && (*in_.rover)[gi].time <= inc.t1) {
+        gnss_update(f, gi, inc.t1, clock_initialized, sum, last_used, last_rejected);
+        ++gi;
+      }
+      std::string why;
+      if (!f.healthy(why)) {
+        failed = true;
+        fail_message = "filter diverged at " + inc.t1.to_string() + ": " + why;
+        return;
+      }
+      if (inc.t1.ns() >= next_out_ns) {
+        while (next_out_ns <= inc.t1.ns()) next_out_ns += out_period_ns;
+        result.epochs.push_back(output(f, inc.t1, stance, last_used, last_rejected));
+        last_used = last_rejected = 0;
+      }
+    };
+
+    for (; sample_index < samples.size(); ++sample_index) {
+      if (po.stop && samples[sample_index].t > *po.stop) break;
+      ++sum.imu_samples;
+      const ins::ImuSample corrected = ins::correct_sample(samples[sample_index], f.x().imu);
+      integrator.push(corrected, on_increment);
+      if (failed) break;
+    }
+    if (in_.rover && po.gnss && o_.mode == Mode::kTightlyCoupled) sum.gnss_epochs_before_start += static_cast<long>(in_.rover->size() - gi);
+    if (failed) {
+      sum.covariance_healthy = false;
+      sum.health_message = fail_message;
+      return make_error(fail_message);
+    }
+    return {};
+  }
+
+  EpochOutput output(const Filter& f, GpsTime t, bool zupt, int used, int rejected) const {
+    Filter& ff = const_cast<Filter&>(f);
+    EpochOutput e;
+    e.t = t;
+    e.nav = ff.x().nav;
+    const Geodetic llh = geodetic_from_ecef(e.nav.p_eb_e);
+    const Eigen::Matrix3d Rne = R_e_n(llh.lat, llh.lon).transpose();
+    e.cov_p_n = Rne * f.P().block<3, 3>(ins::kPos.offset, ins::kPos.offset) * Rne.transpose();
+    e.cov_v_n = Rne * f.P().block<3, 3>(ins::kVel.offset, ins::kVel.offset) * Rne.transpose();
+    const Eigen::Matrix3d att_n = Rne * f.P().block<3, 3>(ins::kAtt.offset, ins::kAtt.offset) * Rne.transpose();
+    e.sd_yaw_rad = std::sqrt(std::max(0.0, att_n(2, 2)));
+    e.n_sats_used = used;
+    e.n_sats_rejected = rejected;
+    e.zupt = zupt;
+    return e;
+  }
+
+  // ZUPT: z = 0 - v_est; form D adds the attitude coupling [v×] (seed 001 eq. 8); ZARU: omega - b_g - omega_ie.
+  void zupt_update(Filter& f, const ins::ImuIncrement& inc) {
+    const int n = f.layout().dim();
+    const Vector3d v = f.x().nav.v_eb_e;
+    const int m = o_.zaru ? 6 : 3;
+    MatrixXd H = MatrixXd::Zero(m, n);
+    VectorXd r(m);
+    MatrixXd R = MatrixXd::Zero(m, m);
+    const Eigen::Matrix<double, 3, 6> J = zupt_jacobian(v, o_.zupt_form);
+    H.block<3, 3>(0, ins::kVel.offset) = J.leftCols<3>();
+    H.block<3, 3>(0, ins::kAtt.offset) = J.rightCols<3>();
+    r.head<3>() = -v;
+    R.topLeftCorner<3, 3>().diagonal().setConstant(o_.zupt_sigma_mps * o_.zupt_sigma_mps);
+    if (o_.zaru) {
+      // Measured rate (corrected by the current bias estimate) should equal the Earth rate in b.
+      const Vector3d omega_ie_b = f.x().nav.R_e_b().transpose() * Vector3d(0, 0, wgs84::kOmegaIE_radps);
+      r.tail<3>() = inc.omega_end_b - omega_ie_b;  // = true bias error if the foot is still
+      H.block<3, 3>(3, ins::kBiasGyro.offset).setIdentity();
+      R.bottomRightCorner<3, 3>().diagonal().setConstant(o_.zaru_sigma_radps * o_.zaru_sigma_radps);
+    }
+    f.update(r, H, R);
+  }
+
+  void count(std::map<std::string, long>& m, const std::string& key) { ++m[key]; }
+
+  // SD (or UD) pseudorange + Doppler update at rover epoch gi, processed at mechanization epoch t_proc >= epoch.
+  void gnss_update(Filter& f, size_t gi, GpsTime t_proc, bool& clock_initialized, EngineSummary& sum, int& used_out,
+                   int& rejected_out) {
+    gnss::ObsEpoch re = (*in_.rover)[gi];
+    if (in_.gnss_mask) {
+      const size_t before = re.sats.size();
+      in_.gnss_mask(re);
+      if (re.sats.empty() && before > 0) {
+        ++sum.gnss_epochs_masked;
+        return;
+      }
+    }
+    const gnss::ObsEpoch* be = nullptr;
+    if (sd_) {
+      if (matches_[gi].base_index < 0) {
+        ++sum.gnss_epochs_skipped_no_base;
+        return;
+      }
+      be = &(*in_.base)[matches_[gi].base_index];
+    }
+    const int n = f.layout().dim();
+    const double lag_s = t_proc - re.time;  // the state is at t_proc; move the antenna back to the epoch
+    const Vector3d p_imu = f.x().nav.p_eb_e - f.x().nav.v_eb_e * lag_s;
+    const Vector3d p_a = p_imu + lever_e(p_imu);
+    const Vector3d v_a = f.x().nav.v_eb_e;
+    const Geodetic llh = geodetic_from_ecef(p_a);
+    std::vector<Row> rows;
+    std::vector<std::vector<double>> code_res_by_slot(o_.systems.size()), dop_res;
+    for (const gnss::SatObs& so : re.sats) {
+      const int slot = system_slot(o_.systems, so.sat.system);
+      if (slot < 0) continue;
+      if (std::isnan(so.pseudorange_m)) { count(sum.code_used_rejected, "no_pseudorange"); continue; }
+      if (!std::isnan(so.cn0_dbhz) && so.cn0_dbhz < o_.min_cn0_dbhz) { count(sum.code_used_rejected, "low_cn0"); continue; }
+      gnss::SignalAtReceiver rs, bs;
+      rs.pseudorange_m = so.pseudorange_m;
+      rs.range_rate_mps = -so.wavelength_m * so.doppler_hz;
+      auto sr = gnss::satellite_state_at_reception(*in_.nav, so.sat, re.time, so.pseudorange_m);
+      if (!sr) { count(sum.code_used_rejected, "no_ephemeris"); continue; }
+      rs.sat = *sr;
+      const gnss::ElevationAzimuth ea = gnss::elevation_azimuth(p_a, sr->p_es_e);
+      if (ea.elevation < o_.elevation_mask_rad) { count(sum.code_used_rejected, "below_elevation_mask"); continue; }
+      double cn0_b = so.cn0_dbhz;
+      gnss::MeasurementRow code, rate;
+      double sigma_c = gnss::measurement_sigma(o_.weights, so.cn0_dbhz, ea.elevation, false);
+      double sigma_d = gnss::measurement_sigma(o_.weights, so.cn0_dbhz, ea.elevation, true);
+      if (so.sat.system == gnss::System::kGlonass) sigma_c *= o_.weights.glonass_code_factor;
+      bool have_rate = o_.use_doppler && std::isfinite(rs.range_rate_mps);
+      if (sd_) {
+        auto it = std::find_if(be->sats.begin(), be->sats.end(), [&](const gnss::SatObs& b) { return b.sat == so.sat; });
+        if (it == be->sats.end() || std::isnan(it->pseudorange_m)) { count(sum.code_used_rejected, "not_at_base"); continue; }
+        auto sb = gnss::satellite_state_at_reception(*in_.nav, so.sat, be->time, it->pseudorange_m);
+        if (!sb) { count(sum.code_used_rejected, "no_ephemeris"); continue; }
+        bs.pseudorange_m = it->pseudorange_m;
+        bs.range_rate_mps = -it->wavelength_m * it->doppler_hz;
+        bs.sat = *sb;
+        cn0_b = it->cn0_dbhz;
+        const double el_b = gnss::elevation_azimuth(*o_.base_position_e, sb->p_es_e).elevation;
+        const double sb_c = gnss::measurement_sigma(o_.weights, cn0_b, el_b, false) *
+                            (so.sat.system == gnss::System::kGlonass ? o_.weights.glonass_code_factor : 1.0);
+        sigma_c = std::hypot(sigma_c, sb_c);
+        sigma_d = std::hypot(sigma_d, gnss::measurement_sigma(o_.weights, cn0_b, el_b, true));
+        code = gnss::sd_pseudorange(so.sat, rs, bs, p_a, *o_.base_position_e, f.clock(slot));
+        have_rate = have_rate && std::isfinite(bs.range_rate_mps);
+        if (have_rate) rate = gnss::sd_range_rate(so.sat, rs, bs, p_a, v_a, *o_.base_position_e, f.drift());
+      } else {
+        const double iono = in_.nav->has_klobuchar ? gnss::klobuchar_delay_m(in_.nav->klobuchar, re.time, llh, ea) : 0.0;
+        const double tropo = gnss::saastamoinen_delay_m(llh, ea.elevation);
+        code = gnss::ud_pseudorange(so.sat, rs, p_a, f.clock(slot), iono, tropo);
+        if (have_rate) rate = gnss::ud_range_rate(so.sat, rs, p_a, v_a, f.drift());
+      }
+      Row rc;
+      rc.sat = so.sat;
+      rc.residual = code.residual;
+      rc.sigma = sigma_c;
+      rc.h = Eigen::RowVectorXd::Zero(n);
+      rc.h.segment<3>(ins::kPos.offset) = code.J_p;
+      rc.h(f.clock_offset(slot)) = code.J_clock;
+      code_res_by_slot[slot].push_back(code.residual);
+      rows.push_back(rc);
+      if (have_rate) {
+        Row rd;
+        rd.sat = so.sat;
+        rd.doppler = true;
+        rd.residual = rate.residual;
+        rd.sigma = sigma_d;
+        rd.h = Eigen::RowVectorXd::Zero(n);
+        rd.h.segment<3>(ins::kPos.offset) = rate.J_p;
+        rd.h.segment<3>(ins::kVel.offset) = rate.J_v;
+        rd.h(f.drift_offset()) = rate.J_drift;
+        rows.push_back(rd);
+      }
+    }
+    if (rows.empty()) return;
+    // Clock initialization / jump detection from the median code innovation per constellation.
+    bool any_reset = false;
+    for (size_t s = 0; s < o_.systems.size(); ++s) {
+      if (code_res_by_slot[s].empty()) continue;
+      const double med = median(code_res_by_slot[s]);
+      const double sd = std::sqrt(f.P()(f.clock_offset(static_cast<int>(s)), f.clock_offset(static_cast<int>(s))));
+      if (!clock_initialized || (std::abs(med) > o_.clock_jump_threshold_m && std::abs(med) > 5.0 * sd)) {
+        if (clock_initialized) ++sum.clock_resets;
+        f.reset_clock(static_cast<int>(s), f.clock(static_cast<int>(s)) + med, 30.0);
+        for (Row& r : rows) {
+          if (!r.doppler && system_slot(o_.systems, r.sat.system) == static_cast<int>(s)) r.residual -= med;
+        }
+        any_reset = true;
+      }
+    }
+    if (!clock_initialized) {
+      std::vector<double> d;
+      for (const Row& r : rows) if (r.doppler) d.push_back(r.residual);
+      if (!d.empty()) {
+        const double med = median(d);
+        f.reset_drift(f.drift() + med, 1.0);
+        for (Row& r : rows) if (r.doppler) r.residual -= med;
+      }
+      clock_initialized = true;
+    }
+    (void)any_reset;
+    // Noise: independent per measurement + the non-rigid antenna offset/velocity common to all satellites.
+    const Eigen::Matrix3d Ren = R_e_n(llh.lat, llh.lon);
+    const Eigen::Matrix3d C_pos = Ren * Vector3d(o_.antenna_sigma_horizontal_m * o_.antenna_sigma_horizontal_m,
+                                                 o_.antenna_sigma_horizontal_m * o_.antenna_sigma_horizontal_m,
+                                                 o_.antenna_sigma_vertical_m * o_.antenna_sigma_vertical_m)
+                                            .asDiagonal() * Ren.transpose();
+    const double svh = o_.antenna_velocity_sigma_horizontal_mps, svv = o_.antenna_velocity_sigma_vertical_mps;
+    const Eigen::Matrix3d C_vel = Ren * Vector3d(svh * svh, svh * svh, svv * svv).asDiagonal() * Ren.transpose();
+    // w-test fault rejection, worst first (Baarda): w_i = (S^-1 nu)_i / sqrt((S^-1)_ii) against chi2(1, p).
+    const double threshold = gnss::chi_square_quantile(o_.fault_probability, 1);
+    std::vector<int> active(rows.size());
+    for (size_t i = 0; i < rows.size(); ++i) active[i] = static_cast<int>(i);
+    int rejected_code = 0;
+    auto build = [&](MatrixXd& H, VectorXd& r, MatrixXd& R) {
+      const int m = static_cast<int>(active.size());
+      H.resize(m, n);
+      r.resize(m);
+      R = MatrixXd::Zero(m, m);
+      for (int i = 0; i < m; ++i) {
+        const Row& a = rows[active[i]];
+        H.row(i) = a.h;
+        r(i) = a.residual;
+        R(i, i) = a.sigma * a.sigma;
+      }
+      for (int i = 0; i < m; ++i) {
+        for (int j = 0; j < m; ++j) {
+          const Row& a = rows[active[i]];
+          const Row& b = rows[active[j]];
+          const Eigen::RowVector3d ja = a.doppler ? Eigen::RowVector3d(a.h.segment<3>(ins::kVel.offset))
+                                                  : Eigen::RowVector3d(a.h.segment<3>(ins::kPos.offset));
+          const Eigen::RowVector3d jb = b.doppler ? Eigen::RowVector3d(b.h.segment<3>(ins::kVel.offset))
+                                                  : Eigen::RowVector3d(b.h.segment<3>(ins::kPos.offset));
+          if (a.doppler == b.doppler) R(i, j) += ja * (a.doppler ? C_vel : C_pos) * jb.transpose();
+        }
+      }
+    };
+    MatrixXd H, R;
+    VectorXd r;
+    for (;;) {
+      build(H, r, R);
+      const MatrixXd S = H * f.P() * H.transpose() + R;
+      const MatrixXd Sinv = S.ldlt().solve(MatrixXd::Identity(S.rows(), S.cols()));
+      const VectorXd a = Sinv * r;
+      int worst = -1;
+      double worst_w2 = threshold;
+      for (int i = 0; i < a.size(); ++i) {
+        const double w2 = a(i) * a(i) / Sinv(i, i);
+        if (w2 > worst_w2) {
+          worst_w2 = w2;
+          worst = i;
+        }
+      }
+      if (worst < 0 || active.size() <= 1) break;
+      const Row& bad = rows[active[worst]];
+      if (bad.doppler) {
+        count(sum.doppler_used_rejected, "innovation_fault");
+      } else {
+        count(sum.code_used_rejected, "innovation_fault");
+        ++rejected_code;
+      }
+      active.erase(active.begin() + worst);
+    }
+    int used_code = 0;
+    for (int i : active) {
+      if (rows[i].doppler) count(sum.doppler_used_rejected, "used");
+      else { count(sum.code_used_rejected, "used"); ++used_code; }
+    }
+    if (f.update(r, H, R)) ++sum.gnss_epochs_used;
+    used_out = used_code;
+    rejected_out = rejected_code;
+  }
+
+ private:
+  const EngineInputs& in_;
+  const EngineOptions& o_;
+  const std::vector<ins::ZuptDecision>& decisions_;
+  std::vector<gnss::BaseMatch> matches_;
+  bool sd_ = false;
+};
+
+// 2D rigid fit (rotation about the vertical + translation) of src onto dst (ENU); returns the rotation angle
+// (counter-clockwise, rad) and the RMS of the residuals [m].
+std::pair<double, double> fit_yaw(const std::vector<Vector3d>& src, const std::vector<Vector3d>& dst) {
+  Vector3d ms = Vector3d::Zero(), md = Vector3d::Zero();
+  for (size_t i = 0; i < src.size(); ++i) ms += src[i], md += dst[i];
+  ms /= static_cast<double>(src.size());
+  md /= static_cast<double>(src.size());
+  double sxx = 0, sxy = 0;
+  for (size_t i = 0; i < src.size(); ++i) {
+    const Vector3d a = src[i] - ms, b = dst[i] - md;
+    sxx += a.x() * b.x() + a.y() * b.y();
+    sxy += a.x() * b.y() - a.y() * b.x();
+  }
+  const double th = std::atan2(sxy, sxx);
+  const double c = std::cos(th), s = std::sin(th);
+  double ss = 0;
+  for (size_t i = 0; i < src.size(); ++i) {
+    const Vector3d a = src[i] - ms, b = dst[i] - md;
+    const double ex = c * a.x() - s * a.y() - b.x(), ey = s * a.x() + c * a.y() - b.y();
+    ss += ex * ex + ey * ey;
+  }
+  return {th, std::sqrt(ss / static_cast<double>(src.size()))};
+}
+
+}  // namespace
+
+Eigen::Matrix<double, 3, 6> zupt_jacobian(const Eigen::Vector3d& v_e, ZuptForm form) {
+  // Error state: v_true = v_est + δv, R_true = exp([φ×]) R_est (docs/error_state.md). The velocity error that an
+  // attitude error alone produces is φ × v̂ = -[v̂×]φ; the dynamic error (seed 001 eq. 5) is δv_dyn = δv + [v̂×]φ,
+  // and form D measures it (seed 001 eq. 8): H = [I, [v̂×]]. Form F measures δv itself: H = [I, 0].
+  Eigen::Matrix<double, 3, 6> J = Eigen::Matrix<double, 3, 6>::Zero();
+  J.leftCols<3>().setIdentity();
+  if (form == ZuptForm::kDynamic) J.rightCols<3>() = skew(v_e);
+  return J;
+}
+
+std::vector<std::string> EngineOptions::problems() const {
+  std::vector<std::string> p = zupt.problems();
+  if (!(mechanization_rate_hz > 0)) p.push_back("mechanization_rate_hz must be > 0");
+  if (!(output_rate_hz > 0)) p.push_back("output.rate_hz must be > 0");
+  if (!(zupt_sigma_mps > 0)) p.push_back("zupt.sigma_mps must be > 0");
+  if (!(fault_probability > 0.5 && fault_probability < 1.0)) p.push_back("fault_rejection.probability must be in (0.5, 1)");
+  for (const auto& s : spec.problems()) p.push_back("imu.spec: " + s);
+  return p;
+}
+
+Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& o) {
+  if (auto p = o.problems(); !p.empty()) {
+    std::string s;
+    for (const auto& x : p) s += (s.empty() ? "" : "; ") + x;
+    return make_error("engine options: " + s);
+  }
+  if (!in.imu || in.imu->size() < 10) return make_error("IMU: fewer than 10 samples");
+  const auto& samples = *in.imu;
+  const bool tc = o.mode == Mode::kTightlyCoupled;
+  if (tc) {
+    if (!in.nav || !in.rover || in.rover->empty()) return make_error("tc mode needs rover observations and nav data");
+    const GpsTime g0 = in.rover->front().time, g1 = in.rover->back().time;
+    if (g1 < samples.front().t || g0 > samples.back().t) {
+      return make_error("GNSS (" + g0.to_string() + " .. " + g1.to_string() + ") and IMU (" +
+                        samples.front().t.to_string() + " .. " + samples.back().t.to_string() +
+                        ") time spans do not overlap");
+    }
+    if (in.base && !o.base_position_e) return make_error("base observations given without a base position");
+  }
+  const std::vector<ins::ZuptDecision> decisions = ins::detect_stance(samples, o.zupt);
+
+  // Start at the first still period (levelling window): the first stance run of >= 0.2 s.
+  size_t s0 = 0, s1 = 0;
+  for (size_t i = 0; i < decisions.size(); ++i) {
+    if (!decisions[i].stance) continue;
+    size_t j = i;
+    while (j + 1 < decisions.size() && decisions[j + 1].stance) ++j;
+    if (samples[j].t - samples[i].t >= 0.2) {
+      s0 = i;
+      s1 = j + 1;
+      break;
+    }
+    i = j;
+  }
+  if (s1 == 0) return make_error("IMU: no still period found to level the IMU (the ZUPT detector never fired)");
+  const std::vector<ins::ImuSample> still(samples.begin() + static_cast<long>(s0), samples.begin() + static_cast<long>(s1));
+
+  EngineResult result;
+  EngineSummary& sum = result.summary;
+  for (const auto& d : decisions) sum.zupt_samples += d.stance;
+  if (in.rover) sum.gnss_epochs = static_cast<long>(in.rover->size());
+  Runner runner(in, o, decisions);
+
+  // Initial position: configured, else the first epoch LSQ solution after the start (antenna -> IMU).
+  Vector3d p0;
+  std::string how;
+  if (o.initial_position_e) {
+    p0 = *o.initial_position_e;
+    how = "position from configuration";
+  } else if (tc) {
+    std::optional<Vector3d> pa;
+    for (size_t g = 0; g < in.rover->size() && !pa; ++g) {
+      if ((*in.rover)[g].time < samples[s0].t) continue;
+      pa = runner.lsq_position(g, o.base_position_e.value_or(Vector3d::Zero()));
+      if (pa) how = "position from the GNSS epoch solution at " + (*in.rover)[g].time.to_string();
+    }
+    if (!pa) return make_error("no GNSS epoch after the IMU start could be solved to initialize the position");
+    p0 = *pa - runner.lever_e(*pa);
+  } else {
+    return make_error("mode ins needs an initial position (initial.position_ecef_m or initial.lat_deg/lon_deg/h_m)");
+  }
+  auto level = ins::coarse_level(still, p0, 0.0, ins::StillnessOptions{1.0, 2.0, 2.0, 0.1});
+  if (!level) return make_error("IMU levelling at " + samples[s0].t.to_string() + ": " + level.error().message);
+  ins::ImuErrors imu0;
+  if (level->duration_s >= 2.0) imu0.b_g = level->gyro_bias_b;
+
+  // Heading: configured, else from motion (INS/ZUPT track with yaw 0 fitted to the GNSS epoch solutions).
+  double yaw0 = 0.0;
+  EngineOptions opt = o;
+  if (o.initial_yaw_rad) {
+    yaw0 = *o.initial_yaw_rad;
+    how += "; heading from configuration";
+  } else if (tc) {
+    // GNSS positions along the first part of the walk.
+    std::vector<std::pair<GpsTime, Vector3d>> lsq;
+    Vector3d first = Vector3d::Zero();
+    GpsTime stop = samples.back().t;
+    Vector3d prev = p0;
+    for (size_t g = 0; g < in.rover->size(); ++g) {
+      if ((*in.rover)[g].time < samples[s0].t) continue;
+      auto pa = runner.lsq_position(g, prev);
+      if (!pa) continue;
+      prev = *pa;
+      if (lsq.empty()) first = *pa;
+      lsq.push_back({(*in.rover)[g].time, *pa});
+      if (enu_from_ecef(*pa, first).head<2>().norm() >= o.heading_init_distance_m) {
+        stop = (*in.rover)[g].time;
+        break;
+      }
+    }
+    EngineOptions ins_only = o;
+    ins_only.mode = Mode::kInsOnly;
+    ins_only.initial_sigma_yaw_rad = 1e-3;
+    EngineResult pass1;
+    PassOptions p1;
+    p1.stop = stop;
+    p1.gnss = false;
+    // Record the INS antenna track at the GNSS epochs by sampling outputs at 20 Hz.
+    ins_only.output_rate_hz = o.mechanization_rate_hz;
+    Runner r1b(in, ins_only, decisions);
+    if (auto ok = r1b.run(s0, ins::nav_state_at_rest(samples[s0].t, p0, level->roll, level->pitch, 0.0), imu0, p1, pass1); !ok) {
+      return make_error("heading initialization pass: " + ok.error().message);
+    }
+    std::vector<Vector3d> src, dst;
+    size_t k = 0;
+    for (const auto& [t, pa] : lsq) {
+      while (k + 1 < pass1.epochs.size() && pass1.epochs[k + 1].t <= t) ++k;
+      if (k >= pass1.epochs.size() || std::abs(pass1.epochs[k].t - t) > 0.06) continue;
+      const Vector3d p_imu = pass1.epochs[k].nav.p_eb_e;
+      src.push_back(enu_from_ecef(p_imu + runner.lever_e(p_imu), first));
+      dst.push_back(enu_from_ecef(pa, first));
+    }
+    if (src.size() < 5 || (dst.back() - dst.front()).head<2>().norm() < 10.0) {
+      return make_error("cannot find the initial heading from motion: the GNSS track moves less than 10 m; set initial.yaw_deg");
+    }
+    auto [theta, rms] = fit_yaw(src, dst);
+    yaw0 = wrap_pi(-theta);  // ENU rotation counter-clockwise by theta = heading change of -theta
+    double spread2 = 0;
+    Vector3d mean = Vector3d::Zero();
+    for (const auto& p : src) mean += p;
+    mean /= static_cast<double>(src.size());
+    for (const auto& p : src) spread2 += (p - mean).head<2>().squaredNorm();
+    const double sigma_yaw = std::clamp(2.0 * rms / std::sqrt(std::max(spread2, 1.0)), 1.0 * kDegToRad, 30.0 * kDegToRad);
+    opt.initial_sigma_yaw_rad = sigma_yaw;
+    sum.heading_fit_rms_m = rms;
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "; heading from motion: INS/ZUPT track fitted to %zu GNSS epoch solutions until %s (fit RMS %.2f m, "
+                  "yaw sigma %.1f deg)",
+                  src.size(), stop.to_string().c_str(), rms, sigma_yaw * kRadToDeg);
+    how += buf;
+  } else {
+    return make_error("mode ins needs an initial heading (initial.yaw_deg)");
+  }
+  sum.initial_yaw_deg = yaw0 * kRadToDeg;
+  sum.initialization = how;
+  Runner runner2(in, opt, decisions);
+  PassOptions po;
+  po.gnss = tc;
+  const ins::NavState nav0 = ins::nav_state_at_rest(samples[s0].t, p0, level->roll, level->pitch, yaw0);
+  if (auto ok = runner2.run(s0, nav0, imu0, po, result); !ok) return ok.error();
+  sum.imu_samples += static_cast<long>(s0);  // samples before the start were used for levelling only
+  return result;
+}
+
+}  // namespace pednav::fusion

@@ -1,0 +1,124 @@
+// The forward engine: closed-loop error-state EKF over one time-ordered stream of IMU samples and GNSS epochs.
+// Mechanization + covariance prediction at the configured rate, ZUPT (form D or F) during detected stance,
+// single-differenced (or undifferenced) pseudorange and Doppler updates with innovation-based fault rejection.
+// No file I/O, no logging: inputs in, trajectory + counts out. Derivations: docs/fusion.md.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/expected.hpp"
+#include "gnss/measurement.hpp"
+#include "gnss/types.hpp"
+#include "ins/error_state.hpp"
+#include "ins/imu.hpp"
+#include "ins/imu_spec.hpp"
+#include "ins/zupt_detector.hpp"
+
+namespace pednav::fusion {
+
+enum class Mode { kTightlyCoupled, kInsOnly };
+enum class ZuptForm { kDynamic /* D, seed 001 eq. 8 */, kFull /* F, seed 001 eq. 9 */ };
+
+struct EngineOptions {
+  Mode mode = Mode::kTightlyCoupled;
+  double mechanization_rate_hz = 20.0;
+  ins::ImuSpec spec;
+  // ZUPT.
+  ins::ZuptDetectorOptions zupt;
+  ZuptForm zupt_form = ZuptForm::kDynamic;
+  double zupt_sigma_mps = 0.02;         ///< ZUPT measurement noise per axis [m/s]
+  bool zaru = false;                    ///< zero angular-rate update during stance
+  double zaru_sigma_radps = 0.01;       ///< [rad/s]
+  // Initial state.
+  std::optional<Eigen::Vector3d> initial_position_e;  ///< IMU position [m] ECEF (ins mode: required)
+  std::optional<double> initial_yaw_rad;              ///< else heading from motion (tc) / error (ins)
+  double heading_init_distance_m = 30.0;              ///< walked GNSS distance used to find the heading
+  double initial_sigma_pos_m = 5.0;
+  double initial_sigma_vel_mps = 0.1;
+  double initial_sigma_tilt_rad = 2.0 * 3.14159265358979323846 / 180.0;
+  double initial_sigma_yaw_rad = 10.0 * 3.14159265358979323846 / 180.0;
+  // GNSS.
+  std::vector<gnss::System> systems{gnss::System::kGps};
+  double elevation_mask_rad = 10.0 * 3.14159265358979323846 / 180.0;
+  double min_cn0_dbhz = 0.0;
+  gnss::WeightModel weights;
+  bool use_doppler = true;
+  Eigen::Vector3d lever_arm_n_m{0.0, 0.0, -1.2};  ///< IMU -> antenna, local level NED [m] (foot -> backpack)
+  double antenna_sigma_horizontal_m = 0.4;   ///< non-rigid arm: antenna offset noise (white) [m]
+  double antenna_sigma_vertical_m = 0.2;
+  double antenna_velocity_sigma_horizontal_mps = 1.0;  ///< foot vs body velocity at the GNSS epoch [m/s]
+  double antenna_velocity_sigma_vertical_mps = 0.3;
+  double clock_psd_m2_per_s = 1.0;            ///< differential clock random walk PSD [m^2/s]
+  double drift_psd_m2_per_s3 = 0.1;           ///< differential drift random walk PSD [m^2/s^3]
+  double clock_jump_threshold_m = 300.0;      ///< median innovation above this resets the clock (ms jumps)
+  double fault_probability = 0.999;           ///< chi-square(1) probability of the w-test
+  double max_base_age_s = 30.0;
+  std::optional<Eigen::Vector3d> base_position_e;  ///< SD when set and base epochs are given
+  // Output.
+  double output_rate_hz = 1.0;
+  /// Every problem at once.
+  std::vector<std::string> problems() const;
+};
+
+/// Everything the engine consumes (GPST throughout).
+struct EngineInputs {
+  const std::vector<ins::ImuSample>* imu = nullptr;
+  const gnss::NavData* nav = nullptr;                 ///< tc only
+  const std::vector<gnss::ObsEpoch>* rover = nullptr; ///< tc only
+  const std::vector<gnss::ObsEpoch>* base = nullptr;  ///< optional (SD)
+  /// GNSS epochs whose time is in this set are skipped (outage masks); satellites of partial outages removed.
+  std::function<void(gnss::ObsEpoch&)> gnss_mask;
+};
+
+/// One output epoch of the forward solution.
+struct EpochOutput {
+  GpsTime t;
+  ins::NavState nav;
+  Eigen::Matrix3d cov_p_n = Eigen::Matrix3d::Zero();  ///< position covariance, NED [m^2]
+  Eigen::Matrix3d cov_v_n = Eigen::Matrix3d::Zero();
+  double sd_yaw_rad = 0.0;
+  int n_sats_used = 0, n_sats_rejected = 0;
+  bool zupt = false;
+};
+
+/// Counts for summary.json: every input accounted for.
+struct EngineSummary {
+  long imu_samples = 0;
+  long mechanization_steps = 0;
+  long zupt_updates = 0;
+  long zupt_samples = 0;             ///< samples flagged as stance by the detector
+  long gnss_epochs = 0;              ///< rover epochs read
+  long gnss_epochs_used = 0;         ///< epochs with at least one accepted measurement
+  long gnss_epochs_skipped_no_base = 0;
+  long gnss_epochs_before_start = 0; ///< before initialization / outside the IMU span
+  long gnss_epochs_masked = 0;
+  long clock_resets = 0;
+  std::map<std::string, long> code_used_rejected;     ///< "used", "fault", "low_cn0", "no_ephemeris", ...
+  std::map<std::string, long> doppler_used_rejected;
+  std::string initialization;        ///< how the state was initialized and when
+  double heading_fit_rms_m = 0.0;
+  double initial_yaw_deg = 0.0;
+  bool covariance_healthy = true;
+  std::string health_message;
+};
+
+struct EngineResult {
+  std::vector<EpochOutput> epochs;
+  EngineSummary summary;
+};
+
+/// Run the forward filter. Fails with a clear message on inputs that cannot be processed (no IMU samples,
+/// no GNSS overlap in tc mode, no initial still period, ...).
+Expected<EngineResult> run_forward(const EngineInputs& inputs, const EngineOptions& options);
+
+/// The ZUPT measurement Jacobian w.r.t. the error state (velocity and attitude blocks) for the estimated
+/// velocity v_e [m/s]: form F: [I 0], form D: [I [v×]] (docs/fusion.md eq. 4.3; seed 001 eq. 8-9).
+Eigen::Matrix<double, 3, 6> zupt_jacobian(const Eigen::Vector3d& v_e, ZuptForm form);
+
+}  // namespace pednav::fusion

@@ -1,0 +1,228 @@
+#include "io/run_command.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "core/geodesy.hpp"
+#include "core/rotation.hpp"
+#include "eval/trajectory.hpp"
+#include "gnss/rtklib/rinex.hpp"
+#include "io/atomic_file.hpp"
+#include "io/compare_command.hpp"
+#include "io/imu_csv.hpp"
+#include "io/solution_writer.hpp"
+#include "io/trajectory_io.hpp"
+
+namespace pednav::io {
+namespace {
+
+gnss::System system_of(const std::string& letter) {
+  if (letter == "R") return gnss::System::kGlonass;
+  if (letter == "E") return gnss::System::kGalileo;
+  if (letter == "C") return gnss::System::kBeidou;
+  if (letter == "J") return gnss::System::kQzss;
+  return gnss::System::kGps;
+}
+
+SolutionRow to_row(const fusion::EpochOutput& e) {
+  SolutionRow r;
+  r.time = e.t;
+  r.p_e = e.nav.p_eb_e;
+  const Geodetic llh = geodetic_from_ecef(e.nav.p_eb_e);
+  const Eigen::Matrix3d Ren = R_e_n(llh.lat, llh.lon);
+  r.v_n = Ren.transpose() * e.nav.v_eb_e;
+  r.rpy_deg = euler_from_R_n_b(Ren.transpose() * e.nav.R_e_b()) * kRadToDeg;
+  r.cov_p_n = e.cov_p_n;
+  r.sd_yaw_deg = e.sd_yaw_rad * kRadToDeg;
+  r.n_sats_used = e.n_sats_used;
+  r.n_sats_rejected = e.n_sats_rejected;
+  r.zupt = e.zupt;
+  r.pos_quality = e.n_sats_used > 0 ? 4 : 5;
+  return r;
+}
+
+}  // namespace
+
+fusion::EngineOptions engine_options(const RunConfig& c) {
+  fusion::EngineOptions o;
+  o.mode = c.mode == "ins" ? fusion::Mode::kInsOnly : fusion::Mode::kTightlyCoupled;
+  o.mechanization_rate_hz = c.mechanization_rate_hz;
+  o.spec = c.imu.spec;
+  o.zupt.detector = c.zupt.detector;
+  o.zupt.mv_window_s = c.zupt.mv_window_s;
+  o.zupt.mv_threshold_mps2 = c.zupt.mv_threshold_mps2;
+  o.zupt.mv_gyro_threshold_radps = c.zupt.mv_gyro_threshold_radps;
+  o.zupt.min_time_since_step_s = c.zupt.min_time_since_step_s;
+  o.zupt.shoe_window_s = c.zupt.shoe_window_s;
+  o.zupt.shoe_sigma_accel_mps2 = c.zupt.shoe_sigma_accel_mps2;
+  o.zupt.shoe_sigma_gyro_radps = c.zupt.shoe_sigma_gyro_radps;
+  o.zupt.shoe_threshold = c.zupt.shoe_threshold;
+  o.zupt.min_stance_s = c.zupt.min_stance_s;
+  o.zupt_form = c.zupt.form == "F" ? fusion::ZuptForm::kFull : fusion::ZuptForm::kDynamic;
+  o.zupt_sigma_mps = c.zupt.sigma_mps;
+  o.zaru = c.zupt.zaru;
+  o.zaru_sigma_radps = c.zupt.zaru_sigma_radps;
+  o.initial_position_e = c.initial.position_e;
+  o.initial_yaw_rad = c.initial.yaw_rad;
+  o.heading_init_distance_m = c.initial.heading_init_distance_m;
+  o.initial_sigma_pos_m = c.initial.sigma_position_m;
+  o.initial_sigma_vel_mps = c.initial.sigma_velocity_mps;
+  o.initial_sigma_tilt_rad = c.initial.sigma_tilt_rad;
+  o.initial_sigma_yaw_rad = c.initial.sigma_yaw_rad;
+  o.systems.clear();
+  for (const auto& s : c.gnss.systems) o.systems.push_back(system_of(s));
+  o.elevation_mask_rad = c.gnss.elevation_mask_rad;
+  o.min_cn0_dbhz = c.gnss.min_cn0_dbhz;
+  o.weights.code_sigma_zenith_m = c.gnss.code_sigma_zenith_m;
+  o.weights.doppler_sigma_zenith_mps = c.gnss.doppler_sigma_zenith_mps;
+  o.weights.cn0_ref_dbhz = c.gnss.cn0_ref_dbhz;
+  o.weights.glonass_code_factor = c.gnss.glonass_code_factor;
+  o.use_doppler = c.gnss.use_doppler;
+  o.max_base_age_s = c.gnss.max_base_age_s;
+  o.lever_arm_n_m = c.antenna.lever_arm_ned_m;
+  o.antenna_sigma_horizontal_m = c.antenna.sigma_horizontal_m;
+  o.antenna_sigma_vertical_m = c.antenna.sigma_vertical_m;
+  o.antenna_velocity_sigma_horizontal_mps = c.antenna.velocity_sigma_horizontal_mps;
+  o.antenna_velocity_sigma_vertical_mps = c.antenna.velocity_sigma_vertical_mps;
+  o.clock_psd_m2_per_s = c.clock.psd_m2_per_s;
+  o.drift_psd_m2_per_s3 = c.clock.drift_psd_m2_per_s3;
+  o.clock_jump_threshold_m = c.clock.jump_threshold_m;
+  o.fault_probability = c.fault_rejection_probability;
+  o.output_rate_hz = c.output.rate_hz;
+  return o;
+}
+
+Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::string& out_dir) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  if (c.mode == "gnss") return make_error(c.source_file + ": mode gnss: use `pednav gnss` (run handles tc and ins)");
+  if (!c.imu.has_format) return make_error(c.source_file + ": imu.format: required for pednav run (a preset name or a column map)");
+  auto imu = read_imu_csv(c.imu.file, c.imu.format);
+  if (!imu) return imu.error();
+  for (const auto& w : imu->report.warnings) spdlog::warn("{}: {}", c.imu.file, w);
+  fusion::EngineOptions opt = engine_options(c);
+  fusion::EngineInputs in;
+  in.imu = &imu->samples;
+  std::optional<gnss::ObsData> rover, base;
+  std::optional<gnss::NavData> nav;
+  if (opt.mode == fusion::Mode::kTightlyCoupled) {
+    gnss::SystemSelection sel{false, false, false, false, false};
+    for (const auto& s : c.gnss.systems) {
+      sel.gps |= s == "G";
+      sel.glonass |= s == "R";
+      sel.galileo |= s == "E";
+      sel.beidou |= s == "C";
+      sel.qzss |= s == "J";
+    }
+    auto r = gnss::read_rinex_obs(c.gnss.rover_obs, sel);
+    if (!r) return r.error();
+    rover = std::move(*r);
+    auto n = gnss::read_rinex_nav(c.gnss.nav);
+    if (!n) return n.error();
+    nav = std::move(*n);
+    in.rover = &rover->epochs;
+    in.nav = &*nav;
+    if (!c.gnss.base_obs.empty()) {
+      auto b = gnss::read_rinex_obs(c.gnss.base_obs, sel);
+      if (!b) return b.error();
+      base = std::move(*b);
+      in.base = &base->epochs;
+      if (c.gnss.base_position_ecef_m) {
+        opt.base_position_e = c.gnss.base_position_ecef_m;
+      } else if (base->has_approx_position) {
+        spdlog::warn("{}: base position taken from the RINEX header APPROX POSITION (approximate; set base_position_ecef_m)",
+                     c.gnss.base_obs);
+        opt.base_position_e = base->approx_position_e;
+      } else {
+        return make_error(c.gnss.base_obs + ": no base position (set base_position_ecef_m)");
+      }
+    }
+  }
+  auto res = fusion::run_forward(in, opt);
+  if (!res) return make_error(c.source_file + ": " + res.error().message);
+  fusion::EngineSummary& sum = res->summary;
+  spdlog::info("initialization: {}", sum.initialization);
+
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) return make_error(out_dir + ": cannot create output folder: " + ec.message());
+  const std::filesystem::path out(out_dir);
+  std::vector<SolutionRow> rows;
+  rows.reserve(res->epochs.size());
+  for (const auto& e : res->epochs) rows.push_back(to_row(e));
+  if (auto ok = write_solution_csv((out / "solution.csv").string(), rows); !ok) return ok.error();
+  if (auto ok = write_solution_pos((out / "solution.pos").string(), rows,
+                                   {"pednav run (" + c.mode + ", forward filter, IMU position)", c.source_file});
+      !ok) {
+    return ok.error();
+  }
+  if (auto ok = write_file_atomic((out / "config.resolved.yaml").string(), to_yaml(c)); !ok) return ok.error();
+  if (c.smoother_enabled) {
+    spdlog::warn("smoother.enabled: RTS smoothing is not implemented yet (issue 6); only the forward solution is written");
+  }
+
+  nlohmann::ordered_json j;
+  j["mode"] = c.mode;
+  j["initialization"] = sum.initialization;
+  j["initial_yaw_deg"] = sum.initial_yaw_deg;
+  j["heading_fit_rms_m"] = sum.heading_fit_rms_m;
+  j["output_epochs"] = res->epochs.size();
+  j["imu"] = {{"file", c.imu.file},
+              {"rows", imu->report.rows},
+              {"samples", imu->report.samples},
+              {"duplicates_dropped", imu->report.duplicates_dropped},
+              {"bad_rows", imu->report.bad_rows},
+              {"gaps", imu->report.gaps},
+              {"longest_gap_s", imu->report.longest_gap_s},
+              {"samples_processed", sum.imu_samples},
+              {"rate_hz", imu->report.rate_hz}};
+  j["mechanization_steps"] = sum.mechanization_steps;
+  j["zupt"] = {{"detector", c.zupt.detector}, {"form", c.zupt.form}, {"updates", sum.zupt_updates},
+               {"stance_samples", sum.zupt_samples}};
+  if (opt.mode == fusion::Mode::kTightlyCoupled) {
+    j["gnss"] = {{"epochs_read", sum.gnss_epochs},
+                 {"epochs_used", sum.gnss_epochs_used},
+                 {"epochs_skipped_no_base", sum.gnss_epochs_skipped_no_base},
+                 {"epochs_outside_imu_span", sum.gnss_epochs_before_start},
+                 {"epochs_masked", sum.gnss_epochs_masked},
+                 {"clock_resets", sum.clock_resets},
+                 {"differential", base.has_value()},
+                 {"code", sum.code_used_rejected},
+                 {"doppler", sum.doppler_used_rejected}};
+  }
+  j["smoother"] = "not implemented (issue 6)";
+  j["covariance_healthy"] = sum.covariance_healthy;
+  j["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+
+  if (!c.reference.file.empty()) {
+    TrajectoryReadOptions ro;
+    auto fmt_ = parse_trajectory_format(c.reference.format);
+    if (fmt_) ro.format = *fmt_;
+    auto ref = read_trajectory(c.reference.file, ro);
+    if (!ref) return ref.error();
+    eval::Trajectory sol;
+    for (const auto& r : rows) sol.points.push_back({r.time, r.p_e});
+    auto ev = eval::compare(sol, ref->trajectory, eval::CompareOptions{});
+    if (!ev) return make_error("evaluation against " + c.reference.file + ": " + ev.error().message);
+    CompareArgs args;
+    args.solution = (out / "solution.csv").string();
+    args.reference = c.reference.file;
+    TrajectoryFile sf;
+    sf.format = "csv";
+    sf.trajectory = sol;
+    if (auto ok = write_file_atomic((out / "evaluation.json").string(), evaluation_json(*ev, args, sf, *ref)); !ok) {
+      return ok.error();
+    }
+    j["evaluation"] = {{"horizontal_rms_m", ev->horizontal_rms_m}, {"horizontal_max_m", ev->horizontal_max_m},
+                       {"availability_pct", ev->availability_pct}, {"lt5_pct", ev->bins_pct[0]}};
+    spdlog::info("vs reference: horizontal RMS {:.2f} m, p95 {:.2f} m, max {:.2f} m, {:.1f} % < 5 m",
+                 ev->horizontal_rms_m, ev->horizontal_p95_m, ev->horizontal_max_m, ev->bins_pct[0]);
+  }
+  if (auto ok = write_file_atomic((out / "summary.json").string(), j.dump(2) + "\n"); !ok) return ok.error();
+  return sum;
+}
+
+}  // namespace pednav::io
