@@ -97,6 +97,13 @@ std::string format_run_config(const sim::Simulation& s, const ScenarioFile& f) {
       s.imu.front().t.week());
   y += "  spec: " + f.imu_spec_preset + "\n";
   y += fmt::format("mechanization_rate_hz: {:g}\n", 20.0);
+  if (!s.has_gnss && !f.real_gnss) {  // mode ins needs the initial position and heading: the truth's
+    const ins::NavState& x0 = s.truth.nav.front();
+    const Geodetic llh = geodetic_from_ecef(x0.p_eb_e);
+    const Eigen::Vector3d rpy = euler_from_R_n_b(R_e_n(llh.lat, llh.lon).transpose() * x0.R_e_b());
+    y += fmt::format("initial:\n  lat_deg: {:.10f}\n  lon_deg: {:.10f}\n  h_m: {:.4f}\n  yaw_deg: {:.6f}\n",
+                     llh.lat * kRadToDeg, llh.lon * kRadToDeg, llh.h_m, rpy.z() * kRadToDeg);
+  }
   if (f.real_gnss) {
     y += "reference:\n  file: " + yaml_path(std::filesystem::absolute(f.real_gnss->reference_file).lexically_normal().string()) +
          "\n  format: " + (f.real_gnss->reference_format.empty() ? "nmea" : f.real_gnss->reference_format) + "\n";
