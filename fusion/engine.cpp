@@ -231,6 +231,7 @@ class Runner {
     size_t sample_index = start;
     int last_used = 0, last_rejected = 0;
     bool failed = false;
+    bool prev_stance = false;  // stance at the previous mechanization epoch (= this interval's start)
     std::string fail_message;
 
     auto on_increment = [&](const ins::ImuIncrement& inc) {
@@ -240,7 +241,7 @@ class Runner {
       // ZUPT (+ ZARU) when the detector flags the sample at the interval end as stance.
       const bool stance = decisions_[std::min(sample_index, decisions_.size() - 1)].stance;
       if (stance) {
-        zupt_update(f, inc);
+        zupt_update(f, inc, prev_stance);
         ++sum.zupt_updates;
       }
       // GNSS epochs up to the interval end.
@@ -248,6 +249,7 @@ class Runner {
         gnss_update(f, gi, inc.t1, clock_initialized, sum, last_used, last_rejected);
         ++gi;
       }
+      prev_stance = stance;
       std::string why;
       if (!f.healthy(why)) {
         failed = true;
@@ -295,10 +297,12 @@ class Runner {
   }
 
   // ZUPT: z = 0 - v_est; form D adds the attitude coupling [v×] (seed 001 eq. 8); ZARU: omega - b_g - omega_ie.
-  void zupt_update(Filter& f, const ins::ImuIncrement& inc) {
+  // ZARU uses the mean (bias-corrected) rate over the interval, only when the whole interval is stance.
+  void zupt_update(Filter& f, const ins::ImuIncrement& inc, bool interval_start_stance) {
     const int n = f.layout().dim();
     const Vector3d v = f.x().nav.v_eb_e;
-    const int m = o_.zaru ? 6 : 3;
+    const bool zaru = o_.zaru && interval_start_stance && inc.dt_s > 0.0;
+    const int m = zaru ? 6 : 3;
     MatrixXd H = MatrixXd::Zero(m, n);
     VectorXd r(m);
     MatrixXd R = MatrixXd::Zero(m, m);
@@ -307,12 +311,13 @@ class Runner {
     H.block<3, 3>(0, ins::kAtt.offset) = J.rightCols<3>();
     r.head<3>() = -v;
     R.topLeftCorner<3, 3>().diagonal().setConstant(o_.zupt_sigma_mps * o_.zupt_sigma_mps);
-    if (o_.zaru) {
+    if (zaru) {
       // Measured rate (corrected by the current bias estimate) should equal the Earth rate in b.
       const Vector3d omega_ie_b = f.x().nav.R_e_b().transpose() * Vector3d(0, 0, wgs84::kOmegaIE_radps);
-      r.tail<3>() = inc.omega_end_b - omega_ie_b;  // = true bias error if the foot is still
+      r.tail<3>() = inc.alpha_b / inc.dt_s - omega_ie_b;  // = true - estimated bias if the foot is still
       H.block<3, 3>(3, ins::kBiasGyro.offset).setIdentity();
-      R.bottomRightCorner<3, 3>().diagonal().setConstant(o_.zaru_sigma_radps * o_.zaru_sigma_radps);
+      const double var = o_.zaru_sigma_radps * o_.zaru_sigma_radps / std::max(1, inc.samples);
+      R.bottomRightCorner<3, 3>().diagonal().setConstant(var);
     }
     f.update(r, H, R);
   }

@@ -33,7 +33,7 @@ struct EngineOptions {
   ins::ZuptDetectorOptions zupt;
   ZuptForm zupt_form = ZuptForm::kDynamic;
   double zupt_sigma_mps = 0.02;         ///< ZUPT measurement noise per axis [m/s]
-  bool zaru = false;                    ///< zero angular-rate update during stance
+  bool zaru = true;                     ///< zero angular-rate update during stance (mean rate of an all-stance interval)
   double zaru_sigma_radps = 0.01;       ///< [rad/s]
   // Initial state.
   std::optional<Eigen::Vector3d> initial_position_e;  ///< IMU position [m] ECEF (ins mode: required)

@@ -69,7 +69,7 @@ struct ZuptConfig {
   double shoe_threshold = 10.0;
   double min_stance_s = 0.04;
   double sigma_mps = 0.02;                ///< ZUPT measurement noise per axis
-  bool zaru = false;
+  bool zaru = true;
   double zaru_sigma_radps = 0.01;         ///< key zaru_sigma_deg_per_s
 };
 
