@@ -34,6 +34,15 @@ Expected<RunConfig> parse_run_config(const std::string& yaml_text, const std::st
       YamlMap ref = top.map("reference");
       ref.path("file", cfg.reference.file, top.has("reference"));
       ref.choice("format", cfg.reference.format, {"csv", "pos", "nmea"});
+      std::vector<double> q;
+      ref.numbers("nmea_qualities", q);
+      for (double v : q) {
+        if (v < 1 || v > 9 || v != static_cast<int>(v)) {
+          ref.problem("nmea_qualities", "GGA fix qualities are integers 1-9");
+          break;
+        }
+        cfg.reference.nmea_qualities.push_back(static_cast<int>(v));
+      }
     }
     {
       YamlMap out = top.map("output");
@@ -97,7 +106,11 @@ std::string to_yaml(const RunConfig& c) {
   }
   if (!c.reference.file.empty()) {
     e << YAML::Key << "reference" << YAML::Value << YAML::BeginMap << YAML::Key << "file" << YAML::Value
-      << c.reference.file << YAML::Key << "format" << YAML::Value << c.reference.format << YAML::EndMap;
+      << c.reference.file << YAML::Key << "format" << YAML::Value << c.reference.format;
+    if (!c.reference.nmea_qualities.empty()) {
+      e << YAML::Key << "nmea_qualities" << YAML::Value << YAML::Flow << c.reference.nmea_qualities;
+    }
+    e << YAML::EndMap;
   }
   e << YAML::Key << "mechanization_rate_hz" << YAML::Value << c.mechanization_rate_hz;
   e << YAML::Key << "zupt" << YAML::Value << YAML::BeginMap << YAML::Key << "detector" << YAML::Value

@@ -53,6 +53,7 @@ struct ImuConfig {
 struct ReferenceConfig {
   std::string file;
   std::string format = "csv";  ///< csv | pos | nmea
+  std::vector<int> nmea_qualities;  ///< GGA fix qualities kept (empty: every valid fix), e.g. [4] = RTK fixed
 };
 
 /// `zupt:` section.

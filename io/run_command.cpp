@@ -201,6 +201,7 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
     TrajectoryReadOptions ro;
     auto fmt_ = parse_trajectory_format(c.reference.format);
     if (fmt_) ro.format = *fmt_;
+    ro.nmea_qualities = std::set<int>(c.reference.nmea_qualities.begin(), c.reference.nmea_qualities.end());
     auto ref = read_trajectory(c.reference.file, ro);
     if (!ref) return ref.error();
     eval::Trajectory sol;
