@@ -337,12 +337,19 @@ class Runner {
       }
     }
     const gnss::ObsEpoch* be = nullptr;
+    std::optional<gnss::ObsEpoch> propagated;
     if (sd_) {
       if (matches_[gi].base_index < 0) {
         ++sum.gnss_epochs_skipped_no_base;
         return;
       }
       be = &(*in_.base)[matches_[gi].base_index];
+      // An older (or later) base epoch is moved to the rover epoch with its own Doppler: the base clock drift is in
+      // the Doppler, so the differential clock stays continuous across base epochs (docs/fusion.md §3).
+      if (std::abs(re.time - be->time) > 1e-3) {
+        propagated = gnss::propagate_base_with_doppler(*be, re.time);
+        be = &*propagated;
+      }
     }
     const int n = f.layout().dim();
     const double lag_s = t_proc - re.time;  // the state is at t_proc; move the antenna back to the epoch
