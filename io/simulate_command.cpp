@@ -107,6 +107,7 @@ std::string format_run_config(const sim::Simulation& s, const ScenarioFile& f) {
   if (f.real_gnss) {
     y += "reference:\n  file: " + yaml_path(std::filesystem::absolute(f.real_gnss->reference_file).lexically_normal().string()) +
          "\n  format: " + (f.real_gnss->reference_format.empty() ? "nmea" : f.real_gnss->reference_format) + "\n";
+    if (f.real_gnss->reference_format == "nmea") y += "  nmea_qualities: [4]   # score against RTK-fixed epochs only\n";
   } else {
     y += "reference:\n  file: truth.csv\n  format: csv\n";
   }
