@@ -1,0 +1,145 @@
+// Seed 001 consistency test (issue 5, ../shared/DESIGN.md "Measurement models"): ZUPT-only on a simulated walk.
+// With form D (seed 001 eq. 8) heading is unobservable and its variance grows as a random walk,
+// P_yaw(k+1) = P_yaw(k) + σ_ω² T per step (seed 001 eq. 19), i.e. at σ_ω² [rad²/s]; with form F (eq. 9) the
+// attitude error leaks into the ZUPT through v̂ × β and the yaw variance is falsely bounded (eq. 24).
+// The test fails if the two forms are swapped. docs/fusion.md §5.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/geodesy.hpp"
+#include "core/rotation.hpp"
+#include "fusion/engine.hpp"
+#include "io/scenario_config.hpp"
+#include "sim/simulator.hpp"
+
+namespace pednav {
+namespace {
+
+// A 4-minute walk around a 40 m x 25 m block (level ground), IMU only.
+const char* kWalkYaml = R"(
+name: zupt_consistency_walk
+seed: 17
+start: {gps_week: 2300, gps_tow_s: 400000}
+origin: {lat_deg: 51.08, lon_deg: -114.13, h_m: 1050}
+route:
+  static_start_s: 10
+  static_end_s: 5
+  waypoints:
+    - {e_m: 0, n_m: 0}
+    - {e_m: 40, n_m: 0}
+    - {e_m: 40, n_m: 25}
+    - {e_m: 0, n_m: 25}
+    - {e_m: 0, n_m: 0}
+    - {e_m: 40, n_m: 0}
+    - {e_m: 40, n_m: 25}
+    - {e_m: 0, n_m: 25}
+    - {e_m: 0, n_m: 0}
+gait: {speed_mps: 1.1, cycle_s: 1.2, stance_fraction: 0.3}
+imu: {rate_hz: 100, spec: crista, errors: true, misalignment_mrad: 0}
+gnss: {enabled: false}
+)";
+
+// Crista-class white noise only, so seed 001 eq. 19 applies (sensor errors r, ε white with PSDs σ_f², σ_ω²).
+// The bias states need a positive (but negligible) variance: 1e-6 rad/s over 250 s adds 6e-8 rad² to P_yaw,
+// < 1e-4 of the σ_ω² T growth.
+constexpr double kStandardGravity = 9.80665;  // [m/s^2] (ug units)
+
+ins::ImuSpec white_noise_spec() {
+  ins::ImuSpec s;
+  s.name = "white_noise";
+  s.gyro_arw = 0.1 * kDegToRad;           // 0.1 deg/s/sqrt(Hz) [rad/sqrt(s)]
+  s.accel_vrw = 200e-6 * kStandardGravity;  // 200 ug/sqrt(Hz) [m/s/sqrt(s)]
+  s.gyro_bias_instability = 1e-6;         // [rad/s]
+  s.gyro_bias_tau_s = 3600.0;
+  s.accel_bias_instability = 1e-5;        // [m/s^2]
+  s.accel_bias_tau_s = 3600.0;
+  return s;
+}
+
+// Issue 5 asks for ±25 %; in the linear model eq. 19 is exact for form D (yaw is driven by gyro noise only), so
+// the covariance (deterministic) is held to ±5 %: ±25 % would also accept form F's 0.83 on this 4-min walk,
+// i.e. would not fail when the forms are swapped. Measured: D with the linearization reset of docs/fusion.md §5.1
+// 0.998, form F 0.828 (falling further on longer walks: seed 001 eq. 24).
+constexpr double kRandomWalkTolerance = 0.05;  // form D: growth rate within ±5 % of σ_ω²
+constexpr double kBoundedRatio = 0.9;          // form F: growth rate below 0.9 σ_ω² (heading falsely observed)
+constexpr double kInitialYawSigmaRad = 1.0 * kDegToRad;
+
+struct YawGrowth {
+  double p_start_rad2 = 0, p_end_rad2 = 0, duration_s = 0;
+  double rate_rad2_per_s() const { return (p_end_rad2 - p_start_rad2) / duration_s; }
+  double max_p_rad2 = 0;
+};
+
+class ZuptConsistency : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    auto file = io::parse_scenario(kWalkYaml, "zupt_consistency.yaml", ".");
+    ASSERT_TRUE(file.has_value()) << file.error().message;
+    sim::Scenario sc = file->scenario;
+    sc.imu.spec = white_noise_spec();
+    auto s = sim::simulate(sc);
+    ASSERT_TRUE(s.has_value()) << s.error().message;
+    sim_ = new sim::Simulation(std::move(*s));
+  }
+  static void TearDownTestSuite() {
+    delete sim_;
+    sim_ = nullptr;
+  }
+
+  static YawGrowth run(fusion::ZuptForm form) {
+    fusion::EngineOptions o;
+    o.mode = fusion::Mode::kInsOnly;
+    o.spec = white_noise_spec();
+    o.zupt_form = form;
+    const ins::NavState& t0 = sim_->truth.nav.front();
+    o.initial_position_e = t0.p_eb_e;
+    const Geodetic llh = geodetic_from_ecef(t0.p_eb_e);
+    const Eigen::Vector3d rpy = euler_from_R_n_b(R_e_n(llh.lat, llh.lon).transpose() * t0.R_e_b());
+    o.initial_yaw_rad = rpy.z();
+    o.initial_sigma_yaw_rad = kInitialYawSigmaRad;
+    fusion::EngineInputs in;
+    in.imu = &sim_->imu;
+    auto r = fusion::run_forward(in, o);
+    EXPECT_TRUE(r.has_value()) << (r ? "" : r.error().message);
+    YawGrowth g;
+    if (!r || r->epochs.size() < 2) return g;
+    EXPECT_TRUE(r->summary.covariance_healthy);
+    EXPECT_GT(r->summary.zupt_updates, 1000);
+    const auto& e = r->epochs;
+    g.p_start_rad2 = e.front().sd_yaw_rad * e.front().sd_yaw_rad;
+    g.p_end_rad2 = e.back().sd_yaw_rad * e.back().sd_yaw_rad;
+    g.duration_s = e.back().t - e.front().t;
+    for (const auto& x : e) g.max_p_rad2 = std::max(g.max_p_rad2, x.sd_yaw_rad * x.sd_yaw_rad);
+    return g;
+  }
+
+  static sim::Simulation* sim_;
+};
+sim::Simulation* ZuptConsistency::sim_ = nullptr;
+
+TEST_F(ZuptConsistency, FormDYawVarianceGrowsAsARandomWalk) {
+  const double q = white_noise_spec().gyro_arw * white_noise_spec().gyro_arw;  // σ_ω² [rad²/s]
+  const YawGrowth g = run(fusion::ZuptForm::kDynamic);
+  const double ratio = g.rate_rad2_per_s() / q;
+  std::printf("[ form D ] yaw variance %.4g -> %.4g rad^2 over %.0f s: growth %.4g rad^2/s = %.3f x sigma_w^2 "
+              "(sigma_w^2 T per 1.2 s step: %.4g rad^2)\n",
+              g.p_start_rad2, g.p_end_rad2, g.duration_s, g.rate_rad2_per_s(), ratio, q * 1.2);
+  EXPECT_NEAR(ratio, 1.0, kRandomWalkTolerance) << "seed 001 eq. 19: P_yaw grows by sigma_w^2 T per step";
+  // A random walk never shrinks: the yaw variance at the end is the largest.
+  EXPECT_NEAR(g.max_p_rad2, g.p_end_rad2, 1e-3 * g.p_end_rad2);
+}
+
+TEST_F(ZuptConsistency, FormFYawVarianceIsFalselyBounded) {
+  const double q = white_noise_spec().gyro_arw * white_noise_spec().gyro_arw;
+  const YawGrowth g = run(fusion::ZuptForm::kFull);
+  const double ratio = g.rate_rad2_per_s() / q;
+  std::printf("[ form F ] yaw variance %.4g -> %.4g rad^2 (max %.4g) over %.0f s: growth %.4g rad^2/s = %.3f x "
+              "sigma_w^2\n",
+              g.p_start_rad2, g.p_end_rad2, g.max_p_rad2, g.duration_s, g.rate_rad2_per_s(), ratio);
+  EXPECT_LT(ratio, kBoundedRatio) << "seed 001 eq. 24: with form F the heading looks observable";
+}
+
+}  // namespace
+}  // namespace pednav
