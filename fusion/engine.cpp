@@ -108,6 +108,18 @@ class Filter {
     if (o_.mode == Mode::kTightlyCoupled) drift_mps_ += dx(drift_block_.offset);
   }
 
+  // P <- J P J^T with J = I except the (velocity, attitude) block = A (docs/fusion.md eq. 5.9).
+  void reexpress_velocity_attitude(const Eigen::Matrix3d& A) {
+    // J P J^T = P + E_v A P_φ· + P_·φ A^T E_v^T + E_v A P_φφ A^T E_v^T
+    const int v = ins::kVel.offset, a = ins::kAtt.offset;
+    const MatrixXd APa = A * P_.middleRows<3>(a);  // A P_φ· (3 x n), from the P before the update
+    const Eigen::Matrix3d APaaAt = A * P_.block<3, 3>(a, a) * A.transpose();
+    P_.middleRows<3>(v) += APa;
+    P_.middleCols<3>(v) += APa.transpose();
+    P_.block<3, 3>(v, v) += APaaAt;
+    P_ = 0.5 * (P_ + P_.transpose());
+  }
+
   // Reset a clock to a new value with a large variance (receiver clock jump).
   void reset_clock(int slot, double value_m, double sigma_m) {
     const int c = clock_blocks_[slot].offset;
@@ -319,7 +331,14 @@ class Runner {
       const double var = o_.zaru_sigma_radps * o_.zaru_sigma_radps / std::max(1, inc.samples);
       R.bottomRightCorner<3, 3>().diagonal().setConstant(var);
     }
-    f.update(r, H, R);
+    const Vector3d v_before = v;
+    if (!f.update(r, H, R)) return;
+    if (o_.zupt_form == ZuptForm::kDynamic) {
+      // The error state is kept in the dynamic-error sense only through v̂; the update moved v̂, so re-express the
+      // covariance at the new v̂: P <- J P J^T, J = I + E_v [(v̂- - v̂+)x] E_φ^T (docs/fusion.md eq. 5.9). Without it
+      // the velocity-yaw correlation left by the swing makes the following stance ZUPTs act like form F.
+      f.reexpress_velocity_attitude(skew(v_before - f.x().nav.v_eb_e));
+    }
   }
 
   void count(std::map<std::string, long>& m, const std::string& key) { ++m[key]; }
