@@ -1,0 +1,98 @@
+// INS/ZUPT (`mode: ins`) on real foot data with the committed configurations of datasets/foot/ (issue 5):
+// x-io short loop closure, and the mean start-aligned horizontal error of one PyShoe Vicon trial. The bounds are the
+// figures measured when the test was written (docs/results.md "INS/ZUPT on real foot data (issue 5)") plus a
+// margin, so a regression shows; they are NOT the issue's targets, which pednav does not meet yet.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "io/compare_command.hpp"
+#include "io/config.hpp"
+#include "io/run_command.hpp"
+#include "tests/support/data.hpp"
+
+namespace pednav::io {
+namespace {
+
+// x-io short_walk, shoe gamma 10, form D: closure measured 2.10 m (x-io's own ZUPT result: 0.082 m).
+constexpr double kXioShortClosureMax_m = 2.6;
+// Path length of the solution: measured 29.9 m (x-io README: about 25 m); a detector that loses stances inflates it.
+constexpr double kXioShortDistanceMin_m = 20.0;
+constexpr double kXioShortDistanceMax_m = 40.0;
+// PyShoe 2018-02-09-11-19-39, same configuration: mean horizontal error measured 0.36 m (PyShoe tuned: 0.047 m).
+constexpr double kPyshoeMeanMax_m = 0.45;
+
+std::filesystem::path temp_dir(const std::string& name) {
+  const auto d = std::filesystem::temp_directory_path() / ("pednav_data_foot_ins_" + name);
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+TEST(DataFootIns, XioShortLoopClosure) {
+  PEDNAV_REQUIRE_DATA(test::shared_data("foot_xio_ngimu_loops/short_walk.csv"));
+  auto cfg = load_run_config(test::source_path("datasets/foot/xio_short.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  const auto out = temp_dir("xio_short");
+  auto sum = run_run_command(*cfg, (out / "run").string());
+  ASSERT_TRUE(sum) << sum.error().message;
+  EXPECT_TRUE(sum->covariance_healthy);
+
+  CompareArgs args;  // the loop: the solution against itself, closure = first-to-last horizontal distance
+  args.solution = args.reference = (out / "run" / "solution.csv").string();
+  args.out_dir = (out / "cmp").string();
+  args.compare.align = eval::Align::kStart;
+  args.compare.loop = true;
+  auto ev = run_compare(args);
+  ASSERT_TRUE(ev) << ev.error().message;
+  std::printf("[xio short] closure %.3f m of %.1f m (%.2f %%), ZUPT updates %ld\n", ev->closure_m, ev->distance_m,
+              ev->closure_pct_of_distance, static_cast<long>(sum->zupt_updates));
+  EXPECT_LT(ev->closure_m, kXioShortClosureMax_m);
+  EXPECT_GT(ev->distance_m, kXioShortDistanceMin_m);
+  EXPECT_LT(ev->distance_m, kXioShortDistanceMax_m);
+}
+
+TEST(DataFootIns, PyshoeTrialMeanError) {
+  const std::string trial = "2018-02-09-11-19-39";
+  const std::string log = test::shared_data("foot_pyshoe_vicon/csv/" + trial + ".csv");
+  PEDNAV_REQUIRE_DATA(log);
+  const auto out = temp_dir("pyshoe");
+  // Reference as scripts/foot_reference writes it: gps_week 0, tow = the log's seconds, e = gt_y, n = gt_x
+  // (the stored Vicon x, y, z-up axes are mirrored w.r.t. a right-handed frame; docs/results.md).
+  {
+    std::ifstream in(log);
+    std::ofstream ref(out / "ref.csv");
+    std::string line;
+    std::getline(in, line);  // header: t_s, 6 IMU columns, gt_x_m, gt_y_m, gt_z_m, label
+    ref << "gps_week,gps_tow_s,e_m,n_m,u_m\n";
+    while (std::getline(in, line)) {
+      std::stringstream ss(line);
+      std::string cell[11];
+      for (auto& c : cell) std::getline(ss, c, ',');
+      ref << "0," << cell[0] << ',' << cell[8] << ',' << cell[7] << ',' << cell[9] << '\n';
+    }
+  }
+  auto cfg = load_run_config(test::source_path("datasets/foot/pyshoe_vicon_" + trial + ".yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  auto sum = run_run_command(*cfg, (out / "run").string());
+  ASSERT_TRUE(sum) << sum.error().message;
+
+  CompareArgs args;
+  args.solution = (out / "run" / "solution.csv").string();
+  args.reference = (out / "ref.csv").string();
+  args.out_dir = (out / "cmp").string();
+  args.compare.align = eval::Align::kStart;
+  auto ev = run_compare(args);
+  ASSERT_TRUE(ev) << ev.error().message;
+  std::printf("[pyshoe %s] mean %.3f m, RMS %.3f m, max %.3f m over %d epochs\n", trial.c_str(),
+              ev->horizontal_mean_m, ev->horizontal_rms_m, ev->horizontal_max_m, ev->epochs_compared);
+  EXPECT_LT(ev->horizontal_mean_m, kPyshoeMeanMax_m);
+  EXPECT_GT(ev->epochs_compared, 500);
+}
+
+}  // namespace
+}  // namespace pednav::io
