@@ -1,5 +1,7 @@
 #include "fusion/engine.hpp"
 
+#include "fusion/rts.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <algorithm>
@@ -81,9 +83,18 @@ class Filter {
         clock_m_[i] += drift_mps_ * dt;
       }
     }
+    if (recording_) P_post_prev_ = P_;
     P_ = m.Phi * P_ * m.Phi.transpose() + m.Qd;
     P_ = 0.5 * (P_ + P_.transpose());
     x_.nav = after;
+    if (recording_) {
+      // What the smoother needs of this step (docs/fusion.md §12): Φ, the prior P, and the affine map
+      // δx⁻ = A δx + d from the error after this step's updates back to the error before them (eq. 12.2).
+      Phi_ = std::move(m.Phi);
+      P_prior_ = P_;
+      A_.setIdentity(P_.rows(), P_.cols());
+      d_.setZero(P_.rows());
+    }
   }
 
   // Joseph-form update with residuals r (measured - predicted), Jacobian H and noise covariance R;
@@ -99,6 +110,7 @@ class Filter {
     P_ = IKH * P_ * IKH.transpose() + K * R * K.transpose();
     P_ = 0.5 * (P_ + P_.transpose());
     apply(dx);
+    if (recording_) d_ += A_ * dx;  // δx_before = δx_after + δx̂ (closed-loop reset), eq. 12.2
     return true;
   }
 
@@ -118,6 +130,8 @@ class Filter {
     P_.middleCols<3>(v) += APa.transpose();
     P_.block<3, 3>(v, v) += APaaAt;
     P_ = 0.5 * (P_ + P_.transpose());
+    // δx_new = J δx_old ⇒ δx⁻ = A J⁻¹ δx_new, J⁻¹ = I − E_v A E_φᵀ (eq. 12.3).
+    if (recording_) A_.middleCols<3>(a) -= A_.middleCols<3>(v) * A;
   }
 
   // Reset a clock to a new value with a large variance (receiver clock jump).
@@ -127,6 +141,7 @@ class Filter {
     P_.row(c).setZero();
     P_.col(c).setZero();
     P_(c, c) = sigma_m * sigma_m;
+    fold_reset_into_prior(c, sigma_m * sigma_m);
   }
   void reset_drift(double value_mps, double sigma_mps) {
     const int d = drift_block_.offset;
@@ -134,7 +149,24 @@ class Filter {
     P_.row(d).setZero();
     P_.col(d).setZero();
     P_(d, d) = sigma_mps * sigma_mps;
+    fold_reset_into_prior(d, sigma_mps * sigma_mps);
   }
+
+  // A reset makes state i a fresh variable, independent of everything before: for the smoother it is part of the
+  // transition of this step (row i of Φ zero, prior variance var, corrections to i before the reset void; eq. 12.11).
+  void fold_reset_into_prior(int i, double var) {
+    if (!recording_) return;
+    Phi_.row(i).setZero();
+    P_prior_.row(i).setZero();
+    P_prior_.col(i).setZero();
+    P_prior_(i, i) = var;
+    d_(i) = 0.0;
+  }
+
+  /// Start keeping the per-step smoother quantities (before the first predict).
+  void record_for_smoother() { recording_ = true; }
+  /// Backward map of the step that just ended (call after all its updates).
+  RtsStep smoother_step() const { return rts_step(P_post_prev_, Phi_, P_prior_, A_, d_); }
 
   bool healthy(std::string& why) const {
     if (!P_.allFinite() || !x_.nav.p_eb_e.allFinite() || !x_.nav.v_eb_e.allFinite()) {
@@ -167,6 +199,10 @@ class Filter {
   MatrixXd P_;
   std::vector<double> clock_m_;
   double drift_mps_ = 0.0;
+  // Smoother: the last step's posterior-before-prediction, transition, prior and update map (eq. 12.2).
+  bool recording_ = false;
+  MatrixXd P_post_prev_, Phi_, P_prior_, A_;
+  VectorXd d_;
 };
 
 double median(std::vector<double> v) {
@@ -227,6 +263,14 @@ class Runner {
     Filter f(o_, static_cast<int>(o_.systems.size()));
     f.init(nav0, imu0);
     EngineSummary& sum = result.summary;
+    // Smoother (docs/fusion.md §12): one composed backward map per output epoch, built step by step.
+    const bool smooth = o_.smoother_enabled;
+    if (smooth) f.record_for_smoother();
+    const int n_state = f.layout().dim();
+    RtsAccumulator acc(n_state);
+    std::vector<RtsSegment> segments;
+    std::vector<ins::InsState> nominal_at_output;
+    bool segment_open = false;
     ins::IncrementOptions io;
     io.rate_hz = o_.mechanization_rate_hz;
     ins::IncrementIntegrator integrator(io);
@@ -268,10 +312,16 @@ class Runner {
         fail_message = "filter diverged at " + inc.t1.to_string() + ": " + why;
         return;
       }
+      if (smooth && segment_open) acc.append(f.smoother_step());
       if (inc.t1.ns() >= next_out_ns) {
         while (next_out_ns <= inc.t1.ns()) next_out_ns += out_period_ns;
-        result.epochs.push_back(output(f, inc.t1, stance, last_used, last_rejected));
+        result.epochs.push_back(output(f.x().nav, f.P(), inc.t1, stance, last_used, last_rejected));
         last_used = last_rejected = 0;
+        if (smooth) {
+          if (segment_open) segments.push_back(acc.take());
+          segment_open = true;
+          nominal_at_output.push_back(f.x());
+        }
       }
     };
 
@@ -288,19 +338,39 @@ class Runner {
       sum.health_message = fail_message;
       return make_error(fail_message);
     }
+    if (smooth && !result.epochs.empty()) {
+      const RtsSegment tail = acc.take();
+      size_t bytes = tail.bytes() + nominal_at_output.size() * sizeof(ins::InsState);
+      for (const auto& s : segments) bytes += s.bytes();
+      const std::vector<RtsSmoothed> sm = rts_backward(segments, tail, f.P());
+      result.smoothed.reserve(result.epochs.size());
+      for (size_t k = 0; k < result.epochs.size(); ++k) {
+        // Smoothed state = forward nominal ⊞ smoothed error (eq. 12.12).
+        const ins::InsState xs = ins::boxplus(nominal_at_output[k], sm[k].dx, f.layout());
+        const EpochOutput& fwd = result.epochs[k];
+        EpochOutput e = output(xs.nav, sm[k].P, fwd.t, fwd.zupt, fwd.n_sats_used, fwd.n_sats_rejected);
+        if (!e.nav.p_eb_e.allFinite() || !sm[k].P.allFinite()) {
+          return make_error("smoother diverged at " + fwd.t.to_string() + ": non-finite smoothed state or covariance");
+        }
+        result.smoothed.push_back(e);
+      }
+      sum.smoothed = true;
+      sum.smoother_records = static_cast<long>(segments.size() + 1);
+      sum.smoother_bytes = static_cast<long>(bytes);
+    }
     return {};
   }
 
-  EpochOutput output(const Filter& f, GpsTime t, bool zupt, int used, int rejected) const {
-    Filter& ff = const_cast<Filter&>(f);
+  // One output epoch from a nominal navigation state and the covariance of its error (forward or smoothed).
+  static EpochOutput output(const ins::NavState& nav, const MatrixXd& P, GpsTime t, bool zupt, int used, int rejected) {
     EpochOutput e;
     e.t = t;
-    e.nav = ff.x().nav;
+    e.nav = nav;
     const Geodetic llh = geodetic_from_ecef(e.nav.p_eb_e);
     const Eigen::Matrix3d Rne = R_e_n(llh.lat, llh.lon).transpose();
-    e.cov_p_n = Rne * f.P().block<3, 3>(ins::kPos.offset, ins::kPos.offset) * Rne.transpose();
-    e.cov_v_n = Rne * f.P().block<3, 3>(ins::kVel.offset, ins::kVel.offset) * Rne.transpose();
-    const Eigen::Matrix3d att_n = Rne * f.P().block<3, 3>(ins::kAtt.offset, ins::kAtt.offset) * Rne.transpose();
+    e.cov_p_n = Rne * P.block<3, 3>(ins::kPos.offset, ins::kPos.offset) * Rne.transpose();
+    e.cov_v_n = Rne * P.block<3, 3>(ins::kVel.offset, ins::kVel.offset) * Rne.transpose();
+    const Eigen::Matrix3d att_n = Rne * P.block<3, 3>(ins::kAtt.offset, ins::kAtt.offset) * Rne.transpose();
     e.sd_yaw_rad = std::sqrt(std::max(0.0, att_n(2, 2)));
     e.n_sats_used = used;
     e.n_sats_rejected = rejected;
@@ -688,6 +758,7 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
     EngineOptions ins_only = o;
     ins_only.mode = Mode::kInsOnly;
     ins_only.initial_sigma_yaw_rad = 1e-3;
+    ins_only.smoother_enabled = false;
     EngineResult pass1;
     PassOptions p1;
     p1.stop = stop;

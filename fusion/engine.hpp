@@ -62,6 +62,8 @@ struct EngineOptions {
   std::optional<Eigen::Vector3d> base_position_e;  ///< SD when set and base epochs are given
   // Output.
   double output_rate_hz = 1.0;
+  /// RTS smoothing of the whole run (docs/fusion.md §12): EngineResult::smoothed at the output epochs.
+  bool smoother_enabled = true;
   /// Every problem at once.
   std::vector<std::string> problems() const;
 };
@@ -106,10 +108,14 @@ struct EngineSummary {
   double initial_yaw_deg = 0.0;
   bool covariance_healthy = true;
   std::string health_message;
+  bool smoothed = false;             ///< the RTS smoother ran (EngineResult::smoothed filled)
+  long smoother_records = 0;         ///< stored backward maps (one per output epoch)
+  long smoother_bytes = 0;           ///< heap bytes of the stored backward maps + nominal states at the outputs
 };
 
 struct EngineResult {
-  std::vector<EpochOutput> epochs;
+  std::vector<EpochOutput> epochs;    ///< forward filter
+  std::vector<EpochOutput> smoothed;  ///< RTS smoothed, same output epochs (empty if the smoother is off)
   EngineSummary summary;
 };
 

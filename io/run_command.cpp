@@ -93,6 +93,7 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.clock_jump_threshold_m = c.clock.jump_threshold_m;
   o.fault_probability = c.fault_rejection_probability;
   o.output_rate_hz = c.output.rate_hz;
+  o.smoother_enabled = c.smoother_enabled;
   return o;
 }
 
@@ -160,8 +161,16 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
     return ok.error();
   }
   if (auto ok = write_file_atomic((out / "config.resolved.yaml").string(), to_yaml(c)); !ok) return ok.error();
-  if (c.smoother_enabled) {
-    spdlog::warn("smoother.enabled: RTS smoothing is not implemented yet (issue 6); only the forward solution is written");
+  std::vector<SolutionRow> smoothed_rows;
+  smoothed_rows.reserve(res->smoothed.size());
+  for (const auto& e : res->smoothed) smoothed_rows.push_back(to_row(e));
+  if (sum.smoothed) {
+    if (auto ok = write_solution_csv((out / "smoothed.csv").string(), smoothed_rows); !ok) return ok.error();
+    if (auto ok = write_solution_pos((out / "solution_smoothed.pos").string(), smoothed_rows,
+                                     {"pednav run (" + c.mode + ", RTS smoothed, IMU position)", c.source_file});
+        !ok) {
+      return ok.error();
+    }
   }
 
   nlohmann::ordered_json j;
@@ -193,7 +202,10 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
                  {"code", sum.code_used_rejected},
                  {"doppler", sum.doppler_used_rejected}};
   }
-  j["smoother"] = "not implemented (issue 6)";
+  j["smoother"] = {{"enabled", c.smoother_enabled},
+                   {"ran", sum.smoothed},
+                   {"stored_records", sum.smoother_records},
+                   {"stored_bytes", sum.smoother_bytes}};
   j["covariance_healthy"] = sum.covariance_healthy;
   j["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
@@ -204,23 +216,36 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
     ro.nmea_qualities = std::set<int>(c.reference.nmea_qualities.begin(), c.reference.nmea_qualities.end());
     auto ref = read_trajectory(c.reference.file, ro);
     if (!ref) return ref.error();
-    eval::Trajectory sol;
-    for (const auto& r : rows) sol.points.push_back({r.time, r.p_e});
-    auto ev = eval::compare(sol, ref->trajectory, eval::CompareOptions{});
-    if (!ev) return make_error("evaluation against " + c.reference.file + ": " + ev.error().message);
-    CompareArgs args;
-    args.solution = (out / "solution.csv").string();
-    args.reference = c.reference.file;
-    TrajectoryFile sf;
-    sf.format = "csv";
-    sf.trajectory = sol;
-    if (auto ok = write_file_atomic((out / "evaluation.json").string(), evaluation_json(*ev, args, sf, *ref)); !ok) {
-      return ok.error();
+    // Forward solution -> evaluation.json (unchanged); smoothed -> evaluation_smoothed.json.
+    auto evaluate = [&](const std::vector<SolutionRow>& rs, const std::string& csv, const std::string& json_name,
+                        const std::string& key, const std::string& what) -> Expected<void> {
+      eval::Trajectory sol;
+      for (const auto& r : rs) sol.points.push_back({r.time, r.p_e});
+      auto ev = eval::compare(sol, ref->trajectory, eval::CompareOptions{});
+      if (!ev) return make_error("evaluation against " + c.reference.file + ": " + ev.error().message);
+      CompareArgs args;
+      args.solution = (out / csv).string();
+      args.reference = c.reference.file;
+      TrajectoryFile sf;
+      sf.format = "csv";
+      sf.trajectory = sol;
+      if (auto ok = write_file_atomic((out / json_name).string(), evaluation_json(*ev, args, sf, *ref)); !ok) {
+        return ok.error();
+      }
+      j[key] = {{"horizontal_rms_m", ev->horizontal_rms_m}, {"horizontal_max_m", ev->horizontal_max_m},
+                {"availability_pct", ev->availability_pct}, {"lt5_pct", ev->bins_pct[0]}};
+      spdlog::info("{} vs reference: horizontal RMS {:.2f} m, p95 {:.2f} m, max {:.2f} m, {:.1f} % < 5 m", what,
+                   ev->horizontal_rms_m, ev->horizontal_p95_m, ev->horizontal_max_m, ev->bins_pct[0]);
+      return {};
+    };
+    if (auto ok = evaluate(rows, "solution.csv", "evaluation.json", "evaluation", "forward"); !ok) return ok.error();
+    if (sum.smoothed) {
+      if (auto ok = evaluate(smoothed_rows, "smoothed.csv", "evaluation_smoothed.json", "evaluation_smoothed",
+                             "smoothed");
+          !ok) {
+        return ok.error();
+      }
     }
-    j["evaluation"] = {{"horizontal_rms_m", ev->horizontal_rms_m}, {"horizontal_max_m", ev->horizontal_max_m},
-                       {"availability_pct", ev->availability_pct}, {"lt5_pct", ev->bins_pct[0]}};
-    spdlog::info("vs reference: horizontal RMS {:.2f} m, p95 {:.2f} m, max {:.2f} m, {:.1f} % < 5 m",
-                 ev->horizontal_rms_m, ev->horizontal_p95_m, ev->horizontal_max_m, ev->bins_pct[0]);
   }
   if (auto ok = write_file_atomic((out / "summary.json").string(), j.dump(2) + "\n"); !ok) return ok.error();
   return sum;
