@@ -350,7 +350,10 @@ class Runner {
         const EpochOutput& fwd = result.epochs[k];
         EpochOutput e = output(xs.nav, sm[k].P, fwd.t, fwd.zupt, fwd.n_sats_used, fwd.n_sats_rejected);
         if (!e.nav.p_eb_e.allFinite() || !sm[k].P.allFinite()) {
-          return make_error("smoother diverged at " + fwd.t.to_string() + ": non-finite smoothed state or covariance");
+          // The forward solution stands; the smoothed one is withheld and the reason reported.
+          sum.smoother_message = "smoother diverged at " + fwd.t.to_string() + ": non-finite smoothed state or covariance";
+          result.smoothed.clear();
+          return {};
         }
         result.smoothed.push_back(e);
       }

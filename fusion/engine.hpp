@@ -111,6 +111,7 @@ struct EngineSummary {
   bool smoothed = false;             ///< the RTS smoother ran (EngineResult::smoothed filled)
   long smoother_records = 0;         ///< stored backward maps (one per output epoch)
   long smoother_bytes = 0;           ///< heap bytes of the stored backward maps + nominal states at the outputs
+  std::string smoother_message;      ///< why the smoother did not produce a solution (empty if it ran or is off)
 };
 
 struct EngineResult {

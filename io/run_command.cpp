@@ -164,6 +164,7 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
   std::vector<SolutionRow> smoothed_rows;
   smoothed_rows.reserve(res->smoothed.size());
   for (const auto& e : res->smoothed) smoothed_rows.push_back(to_row(e));
+  if (!sum.smoother_message.empty()) spdlog::warn("{} (only the forward solution is written)", sum.smoother_message);
   if (sum.smoothed) {
     if (auto ok = write_solution_csv((out / "smoothed.csv").string(), smoothed_rows); !ok) return ok.error();
     if (auto ok = write_solution_pos((out / "solution_smoothed.pos").string(), smoothed_rows,
@@ -206,6 +207,7 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
                    {"ran", sum.smoothed},
                    {"stored_records", sum.smoother_records},
                    {"stored_bytes", sum.smoother_bytes}};
+  if (!sum.smoother_message.empty()) j["smoother"]["message"] = sum.smoother_message;
   j["covariance_healthy"] = sum.covariance_healthy;
   j["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
