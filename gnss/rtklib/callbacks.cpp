@@ -1,14 +1,6 @@
 // The three callbacks librtklib expects its executable to define. pednav reports through return values
 // instead, so they do nothing. Forced into every binary through -Wl,-u (gnss/CMakeLists.txt).
-extern "C" {
-#include "rtklib.h"
-}
-#undef lock
-#undef unlock
-#undef initlock
-#undef thread_t
-#undef lock_t
-#undef PI
+#include "gnss/rtklib/rtklib_c.hpp"
 
 extern "C" {
 int showmsg(const char* /*format*/, ...) { return 0; }

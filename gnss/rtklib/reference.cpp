@@ -1,15 +1,7 @@
 // Test oracle: pednav ephemeris types converted back to RTKLIB's eph_t/geph_t and evaluated by RTKLIB.
 #include "gnss/rtklib/reference.hpp"
 
-extern "C" {
-#include "rtklib.h"
-}
-#undef lock
-#undef unlock
-#undef initlock
-#undef thread_t
-#undef lock_t
-#undef PI
+#include "gnss/rtklib/rtklib_c.hpp"
 
 namespace pednav::gnss::rtklib_reference {
 namespace {

@@ -12,15 +12,7 @@
 
 #include "core/geodesy.hpp"
 
-extern "C" {
-#include "rtklib.h"
-}
-#undef lock
-#undef unlock
-#undef initlock
-#undef thread_t
-#undef lock_t
-#undef PI
+#include "gnss/rtklib/rtklib_c.hpp"
 
 // Debian's librtklib is built with ENAGLO ENAGAL ENAQZS ENACMP ENAIRN NFREQ=5 NEXOBS=3: a different ABI would
 // corrupt memory silently.
