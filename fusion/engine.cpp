@@ -23,6 +23,12 @@ using Eigen::MatrixXd;
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 
+// Plausibility bounds of the nominal state (health check): 6250..6500 km from the centre covers every point from
+// below the Dead Sea to 120 km altitude at any latitude; 100 m/s is far above any foot speed.
+constexpr double kMinRadius_m = 6.25e6;
+constexpr double kMaxRadius_m = 6.5e6;
+constexpr double kMaxSpeed_mps = 100.0;
+
 int system_slot(const std::vector<gnss::System>& systems, gnss::System s) {
   for (size_t i = 0; i < systems.size(); ++i) {
     if (systems[i] == s) return static_cast<int>(i);
@@ -174,10 +180,21 @@ class Filter {
       return false;
     }
     for (int i = 0; i < P_.rows(); ++i) {
-      if (P_(i, i) <= 0.0) {
-        why = "non-positive variance of state " + std::to_string(i);
+      if (P_(i, i) < 0.0) {  // zero is legitimate for a state without uncertainty (e.g. a bias with no noise)
+        why = "negative variance of state " + std::to_string(i);
         return false;
       }
+    }
+    // A walking person stays near the Earth's surface and below vehicle speeds: anything else is divergence,
+    // even while the covariance still looks healthy.
+    const double r_m = x_.nav.p_eb_e.norm();
+    if (r_m < kMinRadius_m || r_m > kMaxRadius_m) {
+      why = "position " + std::to_string(r_m * 1e-3) + " km from the Earth's centre (outside 6250..6500 km)";
+      return false;
+    }
+    if (x_.nav.v_eb_e.norm() > kMaxSpeed_mps) {
+      why = "speed " + std::to_string(x_.nav.v_eb_e.norm()) + " m/s (a walking person stays below 100 m/s)";
+      return false;
     }
     return true;
   }
@@ -665,6 +682,7 @@ std::vector<std::string> EngineOptions::problems() const {
   if (!(zupt_sigma_mps > 0)) p.push_back("zupt.sigma_mps must be > 0");
   if (!(fault_probability > 0.5 && fault_probability < 1.0)) p.push_back("fault_rejection.probability must be in (0.5, 1)");
   for (const auto& s : spec.problems()) p.push_back("imu.spec: " + s);
+
   return p;
 }
 

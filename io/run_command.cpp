@@ -101,6 +101,9 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
   const auto wall0 = std::chrono::steady_clock::now();
   if (c.mode == "gnss") return make_error(c.source_file + ": mode gnss: use `pednav gnss` (run handles tc and ins)");
   if (!c.imu.has_format) return make_error(c.source_file + ": imu.format: required for pednav run (a preset name or a column map)");
+  if (!c.imu.has_spec) {
+    return make_error(c.source_file + ": imu.spec: required for pednav run (a preset name or the noise values)");
+  }
   auto imu = read_imu_csv(c.imu.file, c.imu.format);
   if (!imu) return imu.error();
   for (const auto& w : imu->report.warnings) spdlog::warn("{}: {}", c.imu.file, w);
