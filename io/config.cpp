@@ -67,12 +67,9 @@ Expected<RunConfig> parse_run_config(const std::string& yaml_text, const std::st
 }
 
 Expected<RunConfig> load_run_config(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return make_error(path + ": cannot open configuration file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::filesystem::path p(path);
-  return parse_run_config(ss.str(), path, p.parent_path().empty() ? "." : p.parent_path().string());
+  auto src = read_yaml_source(path, "configuration file");
+  if (!src) return src.error();
+  return parse_run_config(src->text, path, src->base_dir);
 }
 
 std::string to_yaml(const RunConfig& c) {

@@ -298,12 +298,9 @@ Expected<ScenarioFile> parse_scenario(const std::string& yaml_text, const std::s
 }
 
 Expected<ScenarioFile> load_scenario(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return make_error(path + ": cannot open scenario file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::filesystem::path p(path);
-  return parse_scenario(ss.str(), path, p.parent_path().empty() ? "." : p.parent_path().string());
+  auto src = read_yaml_source(path, "scenario file");
+  if (!src) return src.error();
+  return parse_scenario(src->text, path, src->base_dir);
 }
 
 }  // namespace pednav::io

@@ -1,6 +1,7 @@
 #include "io/yaml_schema.hpp"
 
 #include <cmath>
+#include <fstream>
 #include <sstream>
 
 namespace pednav::io {
@@ -27,6 +28,15 @@ bool parse_double(const YAML::Node& n, double& out) {
 }
 
 }  // namespace
+
+Expected<YamlSource> read_yaml_source(const std::string& path, const std::string& what) {
+  std::ifstream in(path);
+  if (!in) return make_error(path + ": cannot open " + what);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::filesystem::path p(path);
+  return YamlSource{ss.str(), p.parent_path().empty() ? "." : p.parent_path().string()};
+}
 
 void YamlProblems::add(const YAML::Node& where, const std::string& path, const std::string& what) {
   std::string loc = file;

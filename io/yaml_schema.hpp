@@ -12,7 +12,17 @@
 #include <string>
 #include <vector>
 
+#include "core/expected.hpp"
+
 namespace pednav::io {
+
+/// The text of a YAML file, and the folder its relative paths are resolved against.
+struct YamlSource {
+  std::string text;
+  std::string base_dir;
+};
+/// Read a whole YAML file; the error is "<path>: cannot open <what>" (what: "configuration file", ...).
+Expected<YamlSource> read_yaml_source(const std::string& path, const std::string& what);
 
 /// Problems found while reading one YAML file.
 struct YamlProblems {
