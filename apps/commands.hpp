@@ -15,5 +15,6 @@ void add_compare_command(CLI::App& app, Action& action);
 void add_gnss_command(CLI::App& app, Action& action);
 void add_simulate_command(CLI::App& app, Action& action);
 void add_run_command(CLI::App& app, Action& action);
+void add_montecarlo_command(CLI::App& app, Action& action);
 
 }  // namespace pednav::apps

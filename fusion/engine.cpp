@@ -305,6 +305,8 @@ class Runner {
     int last_used = 0, last_rejected = 0;
     bool failed = false;
     bool prev_stance = false;  // stance at the previous mechanization epoch (= this interval's start)
+    std::optional<StepTracker> steps;  // seed 000 step-velocity aiding (fusion/step_velocity.hpp)
+    if (o_.step_velocity.enabled) steps.emplace(o_.step_velocity);
     std::string fail_message;
 
     auto on_increment = [&](const ins::ImuIncrement& inc) {
@@ -313,9 +315,12 @@ class Runner {
       ++sum.mechanization_steps;
       // ZUPT (+ ZARU) when the detector flags the sample at the interval end as stance.
       const bool stance = decisions_[std::min(sample_index, decisions_.size() - 1)].stance;
-      if (stance) {
+      if (stance && o_.zupt_updates) {
         zupt_update(f, inc, prev_stance);
         ++sum.zupt_updates;
+      }
+      if (steps) {
+        if (auto m = steps->push(f.x().nav, inc.dt_s, stance)) step_velocity_update(f, *m, sum);
       }
       // GNSS epochs up to the interval end.
       while (po.gnss && o_.mode == Mode::kTightlyCoupled && in_.rover && gi < in_.rover->size() && (*in_.rover)[gi].time <= inc.t1) {
@@ -429,6 +434,16 @@ class Runner {
       // the velocity-yaw correlation left by the swing makes the following stance ZUPTs act like form F.
       f.reexpress_velocity_attitude(skew(v_before - f.x().nav.v_eb_e));
     }
+  }
+
+  // Step-averaged velocity (seed 000 eq. 3): along/cross-track/vertical average velocity of the step vs ΔL/T, applied at the
+  // stance onset that ends the step; state blocks: velocity and attitude (fusion/step_velocity.hpp).
+  void step_velocity_update(Filter& f, const StepMeasurement& m, EngineSummary& sum) {
+    const StepVelocityRows rows = step_velocity_rows(f.x().nav, m, o_.step_velocity);
+    MatrixXd H = MatrixXd::Zero(3, f.layout().dim());
+    H.block<3, 3>(0, ins::kVel.offset) = rows.J_dv_phi.leftCols<3>();
+    H.block<3, 3>(0, ins::kAtt.offset) = rows.J_dv_phi.rightCols<3>();
+    if (f.update(rows.residual, H, rows.cov_meas)) ++sum.step_velocity_updates;
   }
 
   void count(std::map<std::string, long>& m, const std::string& key) { ++m[key]; }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/expected.hpp"
+#include "fusion/step_velocity.hpp"
 #include "gnss/measurement.hpp"
 #include "gnss/types.hpp"
 #include "ins/error_state.hpp"
@@ -35,6 +36,8 @@ struct EngineOptions {
   double zupt_sigma_mps = 0.02;         ///< ZUPT measurement noise per axis [m/s]
   bool zaru = true;                     ///< zero angular-rate update during stance (mean rate of an all-stance interval)
   double zaru_sigma_radps = 0.01;       ///< [rad/s]
+  bool zupt_updates = true;             ///< false: the detector only segments steps (step-velocity-only aiding)
+  StepVelocityOptions step_velocity;    ///< seed 000 step-averaged velocity aiding (fusion/step_velocity.hpp)
   // Initial state.
   std::optional<Eigen::Vector3d> initial_position_e;  ///< IMU position [m] ECEF (ins mode: required)
   std::optional<double> initial_yaw_rad;              ///< else heading from motion (tc) / error (ins)
@@ -95,6 +98,7 @@ struct EngineSummary {
   long mechanization_steps = 0;
   long zupt_updates = 0;
   long zupt_samples = 0;             ///< samples flagged as stance by the detector
+  long step_velocity_updates = 0;    ///< seed 000 step-velocity updates applied
   long gnss_epochs = 0;              ///< rover epochs read
   long gnss_epochs_used = 0;         ///< epochs with at least one accepted measurement
   long gnss_epochs_skipped_no_base = 0;
