@@ -28,6 +28,16 @@ using Eigen::VectorXd;
 constexpr double kMinRadius_m = 6.25e6;
 constexpr double kMaxRadius_m = 6.5e6;
 constexpr double kMaxSpeed_mps = 100.0;
+// ins mode: yaw σ kept inside the filter; the rest of the configured initial heading σ is a frame rotation carried
+// outside it (docs/fusion.md §5.5). Small but non-zero so that P stays positive definite from the first epoch.
+constexpr double kInsFilterSigmaYawRad = 0.1 * 3.14159265358979323846 / 180.0;
+
+// Heading-frame uncertainty of an ins-mode run: variance of a rotation about up_e through origin_e [rad², m].
+struct FrameYaw {
+  double var_rad2 = 0.0;
+  Vector3d origin_e = Vector3d::Zero();
+  Vector3d up_e = Vector3d::UnitZ();
+};
 
 int system_slot(const std::vector<gnss::System>& systems, gnss::System s) {
   for (size_t i = 0; i < systems.size(); ++i) {
@@ -56,7 +66,7 @@ class Filter {
     clock_m_.assign(n_clocks, 0.0);
   }
 
-  void init(const ins::NavState& nav, const ins::ImuErrors& imu) {
+  void init(const ins::NavState& nav, const ins::ImuErrors& imu, double sigma_yaw_rad) {
     x_.nav = nav;
     x_.imu = imu;
     const double st = o_.initial_sigma_tilt_rad;
@@ -65,7 +75,7 @@ class Filter {
     // The attitude block is resolved in e: build it from NED sigmas (tilt, tilt, yaw).
     const Geodetic llh = geodetic_from_ecef(nav.p_eb_e);
     const Eigen::Matrix3d Ren = R_e_n(llh.lat, llh.lon);
-    const Eigen::Matrix3d att_n = Vector3d(st * st, st * st, o_.initial_sigma_yaw_rad * o_.initial_sigma_yaw_rad).asDiagonal();
+    const Eigen::Matrix3d att_n = Vector3d(st * st, st * st, sigma_yaw_rad * sigma_yaw_rad).asDiagonal();
     P_.block<3, 3>(ins::kAtt.offset, ins::kAtt.offset) = Ren * att_n * Ren.transpose();
     for (const auto& b : clock_blocks_) P_(b.offset, b.offset) = 1e12;  // unknown until the first GNSS epoch
     if (o_.mode == Mode::kTightlyCoupled) P_(drift_block_.offset, drift_block_.offset) = 1e6;
@@ -278,7 +288,19 @@ class Runner {
                      EngineResult& result) {
     const auto& samples = *in_.imu;
     Filter f(o_, static_cast<int>(o_.systems.size()));
-    f.init(nav0, imu0);
+    // ins mode: an initial heading error only rotates the whole trajectory about the start point — no ZUPT or ZARU
+    // observes it (H_D s = 0 for the rotation direction s, docs/fusion.md §5.5). Its variance is carried outside the
+    // filter and added to the reported covariance; inside, a large yaw variance would only turn ZUPT model errors
+    // (residual foot motion at stance onset) into heading jumps.
+    frame_ = FrameYaw{};
+    double filter_sigma_yaw_rad = o_.initial_sigma_yaw_rad;
+    if (o_.mode == Mode::kInsOnly && o_.ins_heading_as_frame && filter_sigma_yaw_rad > kInsFilterSigmaYawRad) {
+      frame_.var_rad2 = filter_sigma_yaw_rad * filter_sigma_yaw_rad - kInsFilterSigmaYawRad * kInsFilterSigmaYawRad;
+      frame_.origin_e = nav0.p_eb_e;
+      frame_.up_e = R_e_n(geodetic_from_ecef(nav0.p_eb_e).lat, geodetic_from_ecef(nav0.p_eb_e).lon).col(2) * -1.0;
+      filter_sigma_yaw_rad = kInsFilterSigmaYawRad;
+    }
+    f.init(nav0, imu0, filter_sigma_yaw_rad);
     EngineSummary& sum = result.summary;
     // Smoother (docs/fusion.md §12): one composed backward map per output epoch, built step by step.
     const bool smooth = o_.smoother_enabled;
@@ -387,15 +409,26 @@ class Runner {
   }
 
   // One output epoch from a nominal navigation state and the covariance of its error (forward or smoothed).
-  static EpochOutput output(const ins::NavState& nav, const MatrixXd& P, GpsTime t, bool zupt, int used, int rejected) {
+  EpochOutput output(const ins::NavState& nav, const MatrixXd& P, GpsTime t, bool zupt, int used, int rejected) const {
     EpochOutput e;
     e.t = t;
     e.nav = nav;
     const Geodetic llh = geodetic_from_ecef(e.nav.p_eb_e);
     const Eigen::Matrix3d Rne = R_e_n(llh.lat, llh.lon).transpose();
-    e.cov_p_n = Rne * P.block<3, 3>(ins::kPos.offset, ins::kPos.offset) * Rne.transpose();
-    e.cov_v_n = Rne * P.block<3, 3>(ins::kVel.offset, ins::kVel.offset) * Rne.transpose();
-    const Eigen::Matrix3d att_n = Rne * P.block<3, 3>(ins::kAtt.offset, ins::kAtt.offset) * Rne.transpose();
+    Eigen::Matrix3d cov_p_e = P.block<3, 3>(ins::kPos.offset, ins::kPos.offset);
+    Eigen::Matrix3d cov_v_e = P.block<3, 3>(ins::kVel.offset, ins::kVel.offset);
+    Eigen::Matrix3d cov_att_e = P.block<3, 3>(ins::kAtt.offset, ins::kAtt.offset);
+    if (frame_.var_rad2 > 0.0) {
+      // Rotation of the trajectory by δψ about the vertical through the start (docs/fusion.md eq. 5.10).
+      const Vector3d s_p = frame_.up_e.cross(nav.p_eb_e - frame_.origin_e);
+      const Vector3d s_v = frame_.up_e.cross(nav.v_eb_e);
+      cov_p_e += frame_.var_rad2 * s_p * s_p.transpose();
+      cov_v_e += frame_.var_rad2 * s_v * s_v.transpose();
+      cov_att_e += frame_.var_rad2 * frame_.up_e * frame_.up_e.transpose();
+    }
+    e.cov_p_n = Rne * cov_p_e * Rne.transpose();
+    e.cov_v_n = Rne * cov_v_e * Rne.transpose();
+    const Eigen::Matrix3d att_n = Rne * cov_att_e * Rne.transpose();
     e.sd_yaw_rad = std::sqrt(std::max(0.0, att_n(2, 2)));
     e.n_sats_used = used;
     e.n_sats_rejected = rejected;
@@ -652,6 +685,7 @@ class Runner {
   const std::vector<ins::ZuptDecision>& decisions_;
   std::vector<gnss::BaseMatch> matches_;
   bool sd_ = false;
+  FrameYaw frame_;
 };
 
 // 2D rigid fit (rotation about the vertical + translation) of src onto dst (ENU); returns the rotation angle

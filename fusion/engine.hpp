@@ -46,6 +46,9 @@ struct EngineOptions {
   double initial_sigma_vel_mps = 0.1;
   double initial_sigma_tilt_rad = 2.0 * 3.14159265358979323846 / 180.0;
   double initial_sigma_yaw_rad = 10.0 * 3.14159265358979323846 / 180.0;
+  /// ins mode: carry the initial heading σ outside the filter as a rotation of the trajectory about the start
+  /// (docs/fusion.md §5.5); false keeps all of it in P (used by the seed 001 covariance-recursion test).
+  bool ins_heading_as_frame = true;
   // GNSS.
   std::vector<gnss::System> systems{gnss::System::kGps};
   double elevation_mask_rad = 10.0 * 3.14159265358979323846 / 180.0;
