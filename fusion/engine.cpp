@@ -346,7 +346,8 @@ class Runner {
       }
       // GNSS epochs up to the interval end.
       while (po.gnss && o_.mode == Mode::kTightlyCoupled && in_.rover && gi < in_.rover->size() && (*in_.rover)[gi].time <= inc.t1) {
-        gnss_update(f, gi, inc.t1, clock_initialized, sum, last_used, last_rejected);
+        gnss_update(f, gi, inc.t1, clock_initialized, sum, last_used, last_rejected,
+                    o_.record_gnss_rows ? &result.gnss_rows : nullptr);
         ++gi;
       }
       prev_stance = stance;
@@ -483,7 +484,7 @@ class Runner {
 
   // SD (or UD) pseudorange + Doppler update at rover epoch gi, processed at mechanization epoch t_proc >= epoch.
   void gnss_update(Filter& f, size_t gi, GpsTime t_proc, bool& clock_initialized, EngineSummary& sum, int& used_out,
-                   int& rejected_out) {
+                   int& rejected_out, std::vector<GnssRowRecord>* records) {
     gnss::ObsEpoch re = (*in_.rover)[gi];
     if (in_.gnss_mask) {
       const size_t before = re.sats.size();
@@ -645,11 +646,31 @@ class Runner {
     };
     MatrixXd H, R;
     VectorXd r;
+    const size_t first_record = records ? records->size() : 0;
+    bool first_test = true;
     for (;;) {
       build(H, r, R);
       const MatrixXd S = H * f.P() * H.transpose() + R;
       const MatrixXd Sinv = S.ldlt().solve(MatrixXd::Identity(S.rows(), S.cols()));
       const VectorXd a = Sinv * r;
+      if (records && first_test) {
+        // Baarda's internal reliability: MDB_i = (k + z_0.8) / sqrt((S^-1)_ii), k = sqrt(threshold) (docs/fusion.md eq. 6.4).
+        constexpr double kZPower80 = 0.8416;
+        const double sqrt_lambda = std::sqrt(threshold) + kZPower80;
+        for (int i = 0; i < a.size(); ++i) {
+          const Row& row = rows[active[i]];
+          GnssRowRecord rec;
+          rec.t = re.time;
+          rec.sat = row.sat;
+          rec.doppler = row.doppler;
+          rec.innovation = row.residual;
+          rec.sigma = row.sigma;
+          rec.w = a(i) / std::sqrt(Sinv(i, i));
+          rec.mdb = sqrt_lambda / std::sqrt(Sinv(i, i));
+          records->push_back(rec);
+        }
+      }
+      first_test = false;
       int worst = -1;
       double worst_w2 = threshold;
       for (int i = 0; i < a.size(); ++i) {
@@ -661,6 +682,7 @@ class Runner {
       }
       if (worst < 0 || active.size() <= 1) break;
       const Row& bad = rows[active[worst]];
+      if (records) (*records)[first_record + static_cast<size_t>(active[worst])].rejected = true;
       if (bad.doppler) {
         count(sum.doppler_used_rejected, "innovation_fault");
       } else {

@@ -49,6 +49,8 @@ struct EngineOptions {
   /// ins mode: carry the initial heading σ outside the filter as a rotation of the trajectory about the start
   /// (docs/fusion.md §5.5); false keeps all of it in P (used by the seed 001 covariance-recursion test).
   bool ins_heading_as_frame = true;
+  /// Keep one GnssRowRecord per tested GNSS measurement in EngineResult::gnss_rows (residuals.csv).
+  bool record_gnss_rows = false;
   // GNSS.
   std::vector<gnss::System> systems{gnss::System::kGps};
   double elevation_mask_rad = 10.0 * 3.14159265358979323846 / 180.0;
@@ -121,7 +123,21 @@ struct EngineSummary {
   std::string smoother_message;      ///< why the smoother did not produce a solution (empty if it ran or is off)
 };
 
+/// One tested GNSS measurement of the forward filter's w-test (docs/fusion.md §6): what a user needs to audit the
+/// fault rejection (RTKLIB's .stat residuals play this role). Filled when EngineOptions::record_gnss_rows is set.
+struct GnssRowRecord {
+  GpsTime t;                  ///< rover epoch (GPST)
+  gnss::SatId sat;
+  bool doppler = false;       ///< false: SD (or UD) pseudorange [m]; true: range rate [m/s]
+  double innovation = 0.0;    ///< measured − predicted, after the clock terms [m or m/s]
+  double sigma = 0.0;         ///< measurement σ of the weight model (without the common antenna terms) [m or m/s]
+  double w = 0.0;             ///< Baarda w-statistic in the first test of the epoch (all rows present)
+  double mdb = 0.0;           ///< minimal detectable bias in that test: power 80 % at the configured probability [m or m/s]
+  bool rejected = false;      ///< excluded by the iterative w-test
+};
+
 struct EngineResult {
+  std::vector<GnssRowRecord> gnss_rows;  ///< per tested measurement (only with EngineOptions::record_gnss_rows)
   std::vector<EpochOutput> epochs;    ///< forward filter
   std::vector<EpochOutput> smoothed;  ///< RTS smoothed, same output epochs (empty if the smoother is off)
   EngineSummary summary;

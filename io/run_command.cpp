@@ -12,6 +12,7 @@
 #include "eval/trajectory.hpp"
 #include "gnss/rtklib/rinex.hpp"
 #include "io/atomic_file.hpp"
+#include "io/residuals_writer.hpp"
 #include "io/compare_command.hpp"
 #include "io/imu_csv.hpp"
 #include "io/solution_writer.hpp"
@@ -145,6 +146,7 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
       }
     }
   }
+  opt.record_gnss_rows = opt.mode == fusion::Mode::kTightlyCoupled;  // residuals.csv
   auto res = fusion::run_forward(in, opt);
   if (!res) return make_error(c.source_file + ": " + res.error().message);
   fusion::EngineSummary& sum = res->summary;
@@ -164,6 +166,9 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
     return ok.error();
   }
   if (auto ok = write_file_atomic((out / "config.resolved.yaml").string(), to_yaml(c)); !ok) return ok.error();
+  if (opt.record_gnss_rows) {
+    if (auto ok = write_residuals_csv((out / "residuals.csv").string(), res->gnss_rows); !ok) return ok.error();
+  }
   std::vector<SolutionRow> smoothed_rows;
   smoothed_rows.reserve(res->smoothed.size());
   for (const auto& e : res->smoothed) smoothed_rows.push_back(to_row(e));
