@@ -27,6 +27,9 @@ void add_compare_command(CLI::App& app, Action& action) {
       ->check(CLI::IsMember({"none", "start", "best-fit-2d", "best-fit-3d"}));
   cmd->add_option("--tolerance", args->compare.time_tolerance_s, "Time matching tolerance [s] (default 0.05)");
   cmd->add_flag("--loop", args->compare.loop, "The path is a closed loop: report closure and % of distance");
+  cmd->add_option("--segment", args->segment_s, "Per-segment statistics: segment length [s] (default 120)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("!--no-plot", args->plots, "Do not write the SVG plots");
   cmd->callback([&action, args, sol_format, ref_format, align, qualities] {
     action = [args, sol_format, ref_format, align, qualities] {
       args->solution_read.format = *io::parse_trajectory_format(*sol_format);

@@ -25,6 +25,8 @@ int main(int argc, char** argv) {
   pednav::apps::add_simulate_command(app, action);
   pednav::apps::add_run_command(app, action);
   pednav::apps::add_montecarlo_command(app, action);
+  pednav::apps::add_outage_command(app, action);
+  pednav::apps::add_report_command(app, action);
 
   try {
     app.parse(argc, argv);

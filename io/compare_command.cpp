@@ -1,12 +1,20 @@
 #include "io/compare_command.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/geodesy.hpp"
+#include "eval/outage.hpp"
+#include "eval/statistics.hpp"
 #include "io/atomic_file.hpp"
+#include "io/plot_figures.hpp"
+#include "io/report.hpp"
 
 namespace pednav::io {
 namespace {
@@ -18,6 +26,67 @@ const char* align_name(eval::Align a) {
     case eval::Align::kBestFit3d: return "best-fit-3d";
     default: return "none";
   }
+}
+
+// trajectory_en.svg, error_vs_time.svg (+-3 sigma when the solution is a pednav CSV with sd_n_m/sd_e_m),
+// error_cdf.svg. A plot that cannot be drawn is a warning, not a failure of the comparison.
+void write_compare_plots(const eval::Evaluation& ev, const CompareArgs& args, const TrajectoryFile& sol,
+                         const TrajectoryFile& ref) {
+  const std::filesystem::path out(args.out_dir);
+  auto write = [&](const std::string& name, const PlotSpec& p) {
+    if (auto ok = write_plot_svg((out / name).string(), p); !ok) spdlog::warn("{} not written: {}", name, ok.error().message);
+  };
+  if (ref.trajectory.frame == eval::Frame::kEcef && sol.trajectory.frame == eval::Frame::kEcef &&
+      !ref.trajectory.points.empty()) {
+    std::vector<Eigen::Vector3d> rp, sp;
+    for (const auto& p : ref.trajectory.points) rp.push_back(p.p);
+    for (const auto& p : sol.trajectory.points) sp.push_back(p.p);
+    const Eigen::Vector3d p0 = rp.front();
+    write("trajectory_en.svg", trajectory_plot("Trajectory in local East/North",
+                                               {to_en_track("reference", rp, p0, "#000000"),
+                                                to_en_track("solution", sp, p0, "#1f77b4")}));
+  }
+  if (ev.errors.empty()) return;
+  const GpsTime t0 = ev.errors.front().t;
+  ErrorSeries hs{"solution", {}, {}, "#1f77b4"};
+  for (const auto& e : ev.errors) {
+    hs.t_s.push_back(e.t - t0);
+    hs.value_m.push_back(e.horizontal_m);
+  }
+  write("error_cdf.svg", error_cdf_plot("Horizontal error CDF", {hs}));
+  // Horizontal error with the +-3 sigma_h envelope (sigma_h = sqrt(sd_n^2 + sd_e^2)) when the solution has sigmas.
+  std::map<int64_t, double> sigma_h;
+  if (sol.format == "csv") {
+    if (auto tab = read_csv_table(args.solution)) {
+      const auto* wk = tab->column("gps_week");
+      const auto* tow = tab->column("gps_tow_s");
+      const auto* sn = tab->column("sd_n_m");
+      const auto* se = tab->column("sd_e_m");
+      if (wk && tow && sn && se) {
+        for (size_t i = 0; i < tab->rows; ++i) {
+          if (std::isfinite((*wk)[i]) && std::isfinite((*tow)[i])) {
+            sigma_h[GpsTime::from_week_tow(static_cast<int>((*wk)[i]), (*tow)[i]).ns()] =
+                std::hypot((*sn)[i], (*se)[i]);
+          }
+        }
+      }
+    }
+  }
+  PlotSpec p = horizontal_error_plot("Horizontal error vs time", {hs});
+  if (!sigma_h.empty()) {
+    PlotSeries band;
+    band.title = "0..3σ_h (filter)";
+    band.style = PlotStyle::kBand;
+    band.color = "#1f77b4";
+    for (const auto& e : ev.errors) {
+      auto it = sigma_h.find(e.t.ns());
+      band.x.push_back(e.t - t0);
+      band.y_low.push_back(0.0);
+      band.y_high.push_back(it == sigma_h.end() ? NAN : 3.0 * it->second);
+    }
+    p.series.insert(p.series.begin(), band);
+  }
+  write("error_vs_time.svg", p);
 }
 
 }  // namespace
@@ -41,6 +110,18 @@ std::string evaluation_json(const eval::Evaluation& ev, const CompareArgs& args,
     j["closure_pct_of_distance"] = ev.closure_pct_of_distance;
     j["distance_m"] = ev.distance_m;
   }
+  const eval::VerticalStats v = eval::vertical_statistics(ev.errors);
+  j["vertical"] = {{"rms_m", v.rms_m}, {"mean_m", v.mean_m}, {"std_m", v.std_m}, {"p95_abs_m", v.p95_abs_m},
+                   {"max_abs_m", v.max_abs_m}};
+  nlohmann::ordered_json segs = nlohmann::json::array();
+  for (const auto& sg : eval::segment_statistics(ev.errors, args.segment_s)) {
+    segs.push_back({{"start_gps_tow_s", sg.t_start.tow_s()}, {"end_gps_tow_s", sg.t_end.tow_s()},
+                    {"epochs", sg.epochs}, {"horizontal_rms_m", sg.horizontal_rms_m},
+                    {"horizontal_max_m", sg.horizontal_max_m}, {"vertical_rms_m", sg.vertical_rms_m},
+                    {"mean_e_m", sg.horizontal_mean_e_m}, {"mean_n_m", sg.horizontal_mean_n_m}});
+  }
+  j["segment_s"] = args.segment_s;
+  j["segments"] = segs;
   j["reference_epochs"] = ev.reference_epochs;
   j["align"] = align_name(args.compare.align);
   j["time_tolerance_s"] = args.compare.time_tolerance_s;
@@ -68,9 +149,23 @@ std::string evaluation_markdown(const eval::Evaluation& ev, const CompareArgs& a
     s += fmt::format("| closure | {:.3f} m ({:.2f} % of {:.1f} m) |\n", ev.closure_m, ev.closure_pct_of_distance,
                      ev.distance_m);
   }
+  const eval::VerticalStats v = eval::vertical_statistics(ev.errors);
+  s += fmt::format("| vertical mean / sd | {:.3f} m / {:.3f} m |\n| vertical p95 abs / max abs | {:.3f} m / {:.3f} m |\n",
+                   v.mean_m, v.std_m, v.p95_abs_m, v.max_abs_m);
   s += "\nHorizontal error distribution (layout of seed 004 Tables 1-2):\n\n| < 5 m | 5-10 m | 10-20 m | ≥ 20 m |\n|---|---|---|---|\n";
   s += fmt::format("| {:.1f} % | {:.1f} % | {:.1f} % | {:.1f} % |\n", ev.bins_pct[0], ev.bins_pct[1], ev.bins_pct[2],
                    ev.bins_pct[3]);
+  const auto segs = eval::segment_statistics(ev.errors, args.segment_s);
+  if (!segs.empty()) {
+    s += fmt::format("\nPer-segment statistics ({:g} s segments; GPS seconds of week):\n\n", args.segment_s);
+    s += "| start | end | epochs | horizontal RMS | horizontal max | vertical RMS | mean E | mean N |\n"
+         "|---|---|---|---|---|---|---|---|\n";
+    for (const auto& sg : segs) {
+      s += fmt::format("| {:.1f} | {:.1f} | {} | {:.3f} m | {:.3f} m | {:.3f} m | {:.3f} m | {:.3f} m |\n",
+                       sg.t_start.tow_s(), sg.t_end.tow_s(), sg.epochs, sg.horizontal_rms_m, sg.horizontal_max_m,
+                       sg.vertical_rms_m, sg.horizontal_mean_e_m, sg.horizontal_mean_n_m);
+    }
+  }
   return s;
 }
 
@@ -97,6 +192,13 @@ Expected<eval::Evaluation> run_compare(const CompareArgs& args) {
                        e.d_enu.z(), e.horizontal_m);
   }
   if (auto ok = write_file_atomic((out / "errors.csv").string(), csv); !ok) return ok.error();
+  std::vector<double> horizontal;
+  for (const auto& e : ev->errors) horizontal.push_back(e.horizontal_m);
+  const eval::Cdf cdf = eval::empirical_cdf(horizontal);
+  std::string cdf_csv = "horizontal_m,fraction\n";
+  for (size_t i = 0; i < cdf.value.size(); ++i) cdf_csv += fmt::format("{:.4f},{:.6f}\n", cdf.value[i], cdf.fraction[i]);
+  if (auto ok = write_file_atomic((out / "error_cdf.csv").string(), cdf_csv); !ok) return ok.error();
+  if (args.plots) write_compare_plots(*ev, args, *sol, *ref);
   return ev;
 }
 

@@ -1,0 +1,118 @@
+// `pednav outage` on a short simulated open-sky walk (datasets/circle_304m.yaml): outputs and their columns (DESIGN.md), the partial mask
+// leaves at most N satellites, a full outage empties the epochs and moves the solution away from the run without
+// outage, and bad options name what is wrong.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "io/config.hpp"
+#include "io/outage_command.hpp"
+#include "io/report.hpp"
+#include "io/scenario_config.hpp"
+#include "io/simulate_command.hpp"
+#include "tests/sim/fixtures.hpp"
+
+namespace pednav {
+namespace {
+
+using ::testing::HasSubstr;
+constexpr double kWindowS = 20.0;
+constexpr int kWindows = 2;
+constexpr double kMinFullOutageDrift_m = 0.01;  // 20 s without GNSS must move the solution at least this much
+constexpr double kMaxPartialError_m = 10.0;     // 3 open-sky satellites over 20 s keep the error below this
+
+class OutageCommand : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string(test::temp_dir("outage_sim"));
+    auto f = io::load_scenario("datasets/circle_304m.yaml");  // 243 s: 30 s still, 304 m walked, open sky
+    ASSERT_TRUE(f.has_value()) << f.error().message;
+    ASSERT_TRUE(io::run_simulate_command(*f, *dir_).has_value());
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    dir_ = nullptr;
+  }
+  static io::RunConfig config() {
+    auto c = io::load_run_config(*dir_ + "/config.yaml");
+    EXPECT_TRUE(c.has_value()) << (c ? "" : c.error().message);
+    c->mode = "tc";
+    return *c;
+  }
+  static io::OutageArgs args(const std::string& name, int keep) {
+    io::OutageArgs a;
+    a.out_dir = *dir_ + "/" + name;
+    a.windows = kWindows;
+    a.duration_s = kWindowS;
+    a.keep_sats = keep;
+    a.converged_sigma_horizontal_m = 3.0;
+    a.converged_sigma_yaw_deg = 10.0;
+    a.settle_s = 5.0;
+    return a;
+  }
+  static std::string* dir_;
+};
+std::string* OutageCommand::dir_ = nullptr;
+
+TEST_F(OutageCommand, PartialKeepsAtMostNSatellitesAndWritesTheDesignOutputs) {
+  const io::OutageArgs a = args("keep3", 3);
+  auto r = io::run_outage_command(config(), a);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  ASSERT_EQ(r->windows.size(), static_cast<size_t>(kWindows));
+  EXPECT_EQ(r->against, "reference");  // simulate's config.yaml names truth.csv
+  for (int k = 0; k < kWindows; ++k) {
+    EXPECT_EQ(r->sats_kept_max[k], 3) << k;
+    EXPECT_GE(r->sats_kept_min[k], 3) << "open sky: at least 3 usable satellites at every epoch";
+    EXPECT_EQ(r->epochs_masked[k], 0) << "a partial outage leaves satellites";
+  }
+  EXPECT_LT(r->forward.max_error_m, kMaxPartialError_m);
+  EXPECT_GT(r->forward.max_error_m, 0.0);
+  const std::string rms = test::read_text(a.out_dir + "/rms_vs_time.csv");
+  EXPECT_EQ(rms.substr(0, rms.find('\n')),
+            "t_since_outage_s,rms_horizontal_m,n_windows,rms_horizontal_smoothed_m,n_windows_smoothed");
+  EXPECT_THAT(rms, HasSubstr("\n10,"));
+  const std::string csv = test::read_text(a.out_dir + "/outages.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), kWindows + 1);
+  auto j = nlohmann::json::parse(test::read_text(a.out_dir + "/summary.json"));
+  for (const char* k : {"windows", "duration_s", "keep_sats", "max_error_m", "rms_at_end_m"}) {
+    EXPECT_TRUE(j.contains(k)) << k;
+  }
+  EXPECT_EQ(j["windows"].get<int>(), kWindows);
+  EXPECT_EQ(j["keep_sats"].get<int>(), 3);
+  EXPECT_DOUBLE_EQ(j["max_error_m"].get<double>(), r->forward.max_error_m);
+  EXPECT_TRUE(std::filesystem::exists(a.out_dir + "/outage_rms.svg"));
+  // The outage folder alone is a report folder too.
+  auto rep = io::run_report_command(a.out_dir);
+  ASSERT_TRUE(rep.has_value()) << rep.error().message;
+  EXPECT_EQ(rep->plots, 1);
+}
+
+TEST_F(OutageCommand, FullOutageEmptiesEpochsAndDriftsFromTheRunWithoutOutage) {
+  auto r = io::run_outage_command(config(), args("full", 0));
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  for (int k = 0; k < kWindows; ++k) {
+    EXPECT_GE(r->epochs_masked[k], static_cast<long>(kWindowS) - 1) << k;
+    EXPECT_EQ(r->sats_kept_max[k], 0);
+  }
+  EXPECT_GT(r->forward_vs_run.max_error_m, kMinFullOutageDrift_m);
+}
+
+TEST_F(OutageCommand, BadOptionsAreNamed) {
+  io::OutageArgs a = args("bad", 3);
+  a.windows = 50;
+  auto r = io::run_outage_command(config(), a);
+  ASSERT_FALSE(r.has_value());
+  EXPECT_THAT(r.error().message, HasSubstr("50 x 20 s do not fit"));
+  a = args("bad2", 3);
+  a.against = "truth";
+  EXPECT_THAT(io::run_outage_command(config(), a).error().message, HasSubstr("--against: expected auto"));
+  a = args("bad3", 3);
+  a.start_tow_s = {1.0};
+  EXPECT_THAT(io::run_outage_command(config(), a).error().message, HasSubstr("is outside the run"));
+}
+
+}  // namespace
+}  // namespace pednav

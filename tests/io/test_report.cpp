@@ -1,0 +1,84 @@
+// io/report.*: numeric CSV tables, base64, and report.html of a small synthetic run folder (self-contained:
+// every plot an SVG data URI; sections for the evaluation, trajectory, errors, satellites, ZUPTs, outages).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "core/geodesy.hpp"
+#include "io/report.hpp"
+#include "tests/io/report_fixture.hpp"
+#include "tests/sim/fixtures.hpp"
+
+namespace pednav::io {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+TEST(Report, Base64KnownVectors) {  // RFC 4648 section 10
+  EXPECT_EQ(base64(""), "");
+  EXPECT_EQ(base64("f"), "Zg==");
+  EXPECT_EQ(base64("fo"), "Zm8=");
+  EXPECT_EQ(base64("foo"), "Zm9v");
+  EXPECT_EQ(base64("foobar"), "Zm9vYmFy");
+}
+
+TEST(Report, CsvTableReadsNumbersAndNamesBadLines) {
+  const std::string d = test::temp_dir("csv_table");
+  {
+    std::ofstream f(d + "/a.csv");
+    f << "a,b,c\n1,2.5,\n3,x,4\n";
+  }
+  auto t = read_csv_table(d + "/a.csv");
+  ASSERT_TRUE(t.has_value()) << t.error().message;
+  EXPECT_EQ(t->rows, 2u);
+  ASSERT_NE(t->column("b"), nullptr);
+  EXPECT_DOUBLE_EQ((*t->column("b"))[0], 2.5);
+  EXPECT_TRUE(std::isnan((*t->column("b"))[1]));
+  EXPECT_TRUE(std::isnan((*t->column("c"))[0]));
+  EXPECT_EQ(t->column("zz"), nullptr);
+  {
+    std::ofstream f(d + "/bad.csv");
+    f << "a,b\n1,2\n1,2,3\n";
+  }
+  auto bad = read_csv_table(d + "/bad.csv");
+  ASSERT_FALSE(bad.has_value());
+  EXPECT_THAT(bad.error().message, HasSubstr("bad.csv:3: 3 cells, the header has 2 columns"));
+}
+
+TEST(Report, EmptyFolderIsAnError) {
+  const std::string d = test::temp_dir("report_empty");
+  auto r = run_report_command(d);
+  ASSERT_FALSE(r.has_value());
+  EXPECT_THAT(r.error().message, HasSubstr("nothing to report"));
+  EXPECT_THAT(run_report_command(d + "/missing").error().message, HasSubstr("not a folder"));
+}
+
+TEST(Report, RunFolderGivesSelfContainedHtmlWithEveryPlot) {
+  const std::string d = test::temp_dir("report_run");
+  test::write_report_fixture(d);
+  auto r = run_report_command(d);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  for (const auto& w : r->warnings) ADD_FAILURE() << "warning: " << w;
+  // trajectory, horizontal error, CDF, north +-3 sigma, east +-3 sigma, satellites, ZUPT, outage RMS.
+  EXPECT_EQ(r->plots, test::kReportFixturePlots);
+  const std::string html = test::read_text(d + "/report.html");
+  size_t n_img = 0;
+  for (size_t p = html.find("data:image/svg+xml;base64,"); p != std::string::npos;
+       p = html.find("data:image/svg+xml;base64,", p + 1)) {
+    ++n_img;
+  }
+  EXPECT_EQ(n_img, static_cast<size_t>(test::kReportFixturePlots));
+  EXPECT_THAT(html, HasSubstr("seed 004 Tables 1-2"));
+  EXPECT_THAT(html, HasSubstr("<td>RTS smoothed</td>"));
+  EXPECT_THAT(html, HasSubstr("Outage study: partial outages, 3 satellites kept"));
+  EXPECT_THAT(html, HasSubstr("Per-segment statistics"));
+  EXPECT_THAT(html, Not(HasSubstr("src=\"http")));  // nothing fetched from the network
+  EXPECT_THAT(html, Not(HasSubstr("src=\"file")));
+}
+
+}  // namespace
+}  // namespace pednav::io
