@@ -1,5 +1,6 @@
 #include "fusion/engine.hpp"
 
+#include "fusion/kalman.hpp"
 #include "fusion/rts.hpp"
 
 #include <Eigen/Cholesky>
@@ -7,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <type_traits>
 
 #include "core/geodesy.hpp"
 #include "core/rotation.hpp"
@@ -38,6 +40,8 @@ struct FrameYaw {
   Vector3d origin_e = Vector3d::Zero();
   Vector3d up_e = Vector3d::UnitZ();
 };
+// GNSS update rows held in fixed-capacity matrices (32 satellites with code + Doppler); more use dynamic ones.
+constexpr int kMaxGnssRows = 64;
 
 int system_slot(const std::vector<gnss::System>& systems, gnss::System s) {
   for (size_t i = 0; i < systems.size(); ++i) {
@@ -51,20 +55,36 @@ struct Row {
   gnss::SatId sat;
   bool doppler = false;
   double residual = 0.0;
-  Eigen::RowVectorXd h;
+  ins::ErrorRowVector h;
   double sigma = 0.0;
 };
 
-// The filter state: nominal INS state + differential clocks, error covariance.
+// The filter state: nominal INS state + differential clocks, error covariance. Matrices have a fixed capacity
+// (ins::ErrorMatrix): nothing here allocates on the heap per step (docs/performance.md).
 class Filter {
  public:
   Filter(const EngineOptions& o, int n_clocks) : o_(o) {
     if (o.mode == Mode::kTightlyCoupled) {
-      for (int i = 0; i < n_clocks; ++i) clock_blocks_.push_back(*layout_.add("clock_" + std::to_string(i), 1));
-      drift_block_ = *layout_.add("drift", 1);
+      for (int i = 0; i < n_clocks; ++i) {
+        auto b = layout_.add("clock_" + std::to_string(i), 1);
+        if (!b) {
+          problem_ = b.error().message;
+          return;
+        }
+        clock_blocks_.push_back(*b);
+      }
+      auto d = layout_.add("drift", 1);
+      if (!d) {
+        problem_ = d.error().message;
+        return;
+      }
+      drift_block_ = *d;
     }
     clock_m_.assign(n_clocks, 0.0);
   }
+
+  /// Why the filter cannot run (e.g. more states than ins::kMaxErrorDim), empty if it can.
+  const std::string& problem() const { return problem_; }
 
   void init(const ins::NavState& nav, const ins::ImuErrors& imu, double sigma_yaw_rad) {
     x_.nav = nav;
@@ -99,38 +119,51 @@ class Filter {
         clock_m_[i] += drift_mps_ * dt;
       }
     }
-    if (recording_) P_post_prev_ = P_;
-    P_ = m.Phi * P_ * m.Phi.transpose() + m.Qd;
-    P_ = 0.5 * (P_ + P_.transpose());
+    Phi_sparse_.assign(m.Phi);
+    if (recording_) {
+      // A run of steps without updates is one smoother step with the product of the transitions (docs/fusion.md
+      // eq. 12.13): keep the posterior at the run's start and compose Φ.
+      if (!run_open_) {
+        P_post_prev_ = P_;
+        Phi_ = m.Phi;
+        run_open_ = true;
+        run_steps_ = 1;
+      } else {
+        Phi_sparse_.times(Phi_, tmp_);
+        Phi_ = tmp_;
+        ++run_steps_;
+      }
+    }
+    covariance_predict(P_, Phi_sparse_, m.Qd, tmp_);
+    // Φ P of a one-step run is the smoother's Φ P_post (rts_step): keep it instead of recomputing it.
+    if (recording_ && run_steps_ == 1) PhiP_ = tmp_;
     x_.nav = after;
     if (recording_) {
-      // What the smoother needs of this step (docs/fusion.md §12): Φ, the prior P, and the affine map
-      // δx⁻ = A δx + d from the error after this step's updates back to the error before them (eq. 12.2).
-      Phi_ = std::move(m.Phi);
+      // What the smoother needs of this step (docs/fusion.md §12): the prior P and the affine map δx⁻ = A δx + d
+      // from the error after this step's updates back to the error before them (eq. 12.2).
       P_prior_ = P_;
       A_.setIdentity(P_.rows(), P_.cols());
       d_.setZero(P_.rows());
+      step_updated_ = false;
+      reset_in_step_ = false;
     }
   }
 
   // Joseph-form update with residuals r (measured - predicted), Jacobian H and noise covariance R;
   // the correction is fed back into the nominal state (closed loop) and the error state reset to zero.
-  bool update(const VectorXd& r, const MatrixXd& H, const MatrixXd& R) {
-    const MatrixXd PHt = P_ * H.transpose();
-    const MatrixXd S = H * PHt + R;
-    Eigen::LDLT<MatrixXd> ldlt(S);
-    if (ldlt.info() != Eigen::Success) return false;
-    const MatrixXd K = ldlt.solve(PHt.transpose()).transpose();
-    const VectorXd dx = K * r;
-    const MatrixXd IKH = MatrixXd::Identity(P_.rows(), P_.cols()) - K * H;
-    P_ = IKH * P_ * IKH.transpose() + K * R * K.transpose();
-    P_ = 0.5 * (P_ + P_.transpose());
+  template <typename MatH, typename VecR, typename MatR>
+  bool update(const VecR& r, const MatH& H, const MatR& R) {
+    ErrorVector dx;
+    if (!joseph_update(P_, H, r, R, dx, tmp_)) return false;
     apply(dx);
-    if (recording_) d_ += A_ * dx;  // δx_before = δx_after + δx̂ (closed-loop reset), eq. 12.2
+    if (recording_) {
+      d_.noalias() += A_ * dx;  // δx_before = δx_after + δx̂ (closed-loop reset), eq. 12.2
+      step_updated_ = true;
+    }
     return true;
   }
 
-  void apply(const VectorXd& dx) {
+  void apply(const ErrorVector& dx) {
     x_ = ins::boxplus(x_, dx, layout_);
     for (size_t i = 0; i < clock_blocks_.size(); ++i) clock_m_[i] += dx(clock_blocks_[i].offset);
     if (o_.mode == Mode::kTightlyCoupled) drift_mps_ += dx(drift_block_.offset);
@@ -140,14 +173,18 @@ class Filter {
   void reexpress_velocity_attitude(const Eigen::Matrix3d& A) {
     // J P J^T = P + E_v A P_φ· + P_·φ A^T E_v^T + E_v A P_φφ A^T E_v^T
     const int v = ins::kVel.offset, a = ins::kAtt.offset;
-    const MatrixXd APa = A * P_.middleRows<3>(a);  // A P_φ· (3 x n), from the P before the update
+    Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3, ins::kMaxErrorDim> APa;
+    APa.noalias() = A * P_.middleRows<3>(a);  // A P_φ· (3 x n), from the P before the update
     const Eigen::Matrix3d APaaAt = A * P_.block<3, 3>(a, a) * A.transpose();
     P_.middleRows<3>(v) += APa;
     P_.middleCols<3>(v) += APa.transpose();
     P_.block<3, 3>(v, v) += APaaAt;
-    P_ = 0.5 * (P_ + P_.transpose());
+    P_ = 0.5 * (P_ + P_.transpose()).eval();
     // δx_new = J δx_old ⇒ δx⁻ = A J⁻¹ δx_new, J⁻¹ = I − E_v A E_φᵀ (eq. 12.3).
-    if (recording_) A_.middleCols<3>(a) -= A_.middleCols<3>(v) * A;
+    if (recording_) {
+      A_.middleCols<3>(a) -= A_.middleCols<3>(v) * A;
+      step_updated_ = true;
+    }
   }
 
   // Reset a clock to a new value with a large variance (receiver clock jump).
@@ -177,12 +214,28 @@ class Filter {
     P_prior_.col(i).setZero();
     P_prior_(i, i) = var;
     d_(i) = 0.0;
+    step_updated_ = true;
+    reset_in_step_ = true;
   }
 
   /// Start keeping the per-step smoother quantities (before the first predict).
   void record_for_smoother() { recording_ = true; }
-  /// Backward map of the step that just ended (call after all its updates).
-  RtsStep smoother_step() const { return rts_step(P_post_prev_, Phi_, P_prior_, A_, d_); }
+  /// Whether the step that just ended changed the covariance by an update or reset (then its backward map must be
+  /// closed at this step; otherwise the next step's transition may be composed into it, eq. 12.13).
+  bool step_updated() const { return step_updated_; }
+  /// Backward map of the run of steps that just ended (call after all updates of its last step); the next
+  /// predict() starts a new run.
+  void smoother_step(RtsStep& out) {
+    if (run_steps_ != 1) PhiP_.noalias() = Phi_ * P_post_prev_;
+    // A reset folded into Φ (eq. 12.11) zeroes rows of Φ after Φ P was kept: recompute it then.
+    if (reset_in_step_) PhiP_.noalias() = Phi_ * P_post_prev_;
+    rts_step(P_post_prev_, Phi_, P_prior_, A_, d_, PhiP_, out);
+    run_open_ = false;
+  }
+  /// Whether steps have been predicted since the last closed run.
+  bool run_open() const { return run_open_; }
+  /// End the current run without computing its map (before the first output epoch nothing is stored).
+  void drop_smoother_step() { run_open_ = false; }
 
   bool healthy(std::string& why) const {
     if (!P_.allFinite() || !x_.nav.p_eb_e.allFinite() || !x_.nav.v_eb_e.allFinite()) {
@@ -211,7 +264,7 @@ class Filter {
 
   const ins::ErrorStateLayout& layout() const { return layout_; }
   ins::InsState& x() { return x_; }
-  const MatrixXd& P() const { return P_; }
+  const ErrorMatrix& P() const { return P_; }
   double clock(int slot) const { return clock_m_[slot]; }
   double drift() const { return drift_mps_; }
   int clock_offset(int slot) const { return clock_blocks_[slot].offset; }
@@ -220,19 +273,28 @@ class Filter {
  private:
   const EngineOptions& o_;
   ins::ErrorStateLayout layout_;
+  std::string problem_;
   std::vector<ins::Block> clock_blocks_;
   ins::Block drift_block_{0, 0};
   ins::InsState x_;
-  MatrixXd P_;
+  ErrorMatrix P_;
+  ErrorMatrix tmp_;
   std::vector<double> clock_m_;
   double drift_mps_ = 0.0;
-  // Smoother: the last step's posterior-before-prediction, transition, prior and update map (eq. 12.2).
+  // Smoother: the posterior at the start of the current run of steps, the run's composed transition, the last
+  // step's prior and update map (eqs. 12.2, 12.13).
   bool recording_ = false;
-  MatrixXd P_post_prev_, Phi_, P_prior_, A_;
-  VectorXd d_;
+  bool run_open_ = false;
+  bool step_updated_ = false;
+  bool reset_in_step_ = false;
+  int run_steps_ = 0;
+  ColumnSparse<ins::kMaxErrorDim> Phi_sparse_;
+  ErrorMatrix P_post_prev_, Phi_, P_prior_, A_, PhiP_;
+  ErrorVector d_;
 };
 
-double median(std::vector<double> v) {
+// Median of v (reorders v; no copy).
+double median(std::vector<double>& v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
@@ -254,6 +316,17 @@ class Runner {
       matches_ = gnss::match_base_epochs(rt, bt, o.max_base_age_s);
       sd_ = true;
     }
+    // Per-epoch buffers sized once for the largest epoch (no reallocation on the per-epoch path).
+    size_t max_sats = 0;
+    if (in.rover) {
+      for (const auto& e : *in.rover) max_sats = std::max(max_sats, e.sats.size());
+    }
+    re_.sats.reserve(max_sats);
+    rows_.reserve(2 * max_sats);
+    code_res_by_slot_.resize(o.systems.size());
+    for (auto& v : code_res_by_slot_) v.reserve(max_sats);
+    doppler_res_.reserve(max_sats);
+    active_.reserve(2 * max_sats);
   }
 
   Vector3d lever_e(const Vector3d& p_e) const {
@@ -288,6 +361,7 @@ class Runner {
                      EngineResult& result) {
     const auto& samples = *in_.imu;
     Filter f(o_, static_cast<int>(o_.systems.size()));
+    if (!f.problem().empty()) return make_error(f.problem());
     // ins mode: an initial heading error only rotates the whole trajectory about the start point — no ZUPT or ZARU
     // observes it (H_D s = 0 for the rotation direction s, docs/fusion.md §5.5). Its variance is carried outside the
     // filter and added to the reported covariance; inside, a large yaw variance would only turn ZUPT model errors
@@ -307,8 +381,18 @@ class Runner {
     if (smooth) f.record_for_smoother();
     const int n_state = f.layout().dim();
     RtsAccumulator acc(n_state);
-    std::vector<RtsSegment> segments;
+    RtsStep step;
+    RtsStore segments(n_state);
     std::vector<ins::InsState> nominal_at_output;
+    // Storage sized once from the data span (no reallocation on the per-epoch path; docs/performance.md).
+    const double span_s = std::max(0.0, in_.imu->back().t - nav0.t);
+    const size_t expected_outputs = static_cast<size_t>(span_s * o_.output_rate_hz) + 2;
+    result.epochs.reserve(result.epochs.size() + expected_outputs);
+    if (smooth) {
+      segments.reserve(expected_outputs);
+      nominal_at_output.reserve(expected_outputs);
+    }
+    if (o_.record_gnss_rows && in_.rover) result.gnss_rows.reserve(result.gnss_rows.size() + in_.rover->size() * rows_.capacity());
     bool segment_open = false;
     ins::IncrementOptions io;
     io.rate_hz = o_.mechanization_rate_hz;
@@ -357,17 +441,27 @@ class Runner {
         fail_message = "filter diverged at " + inc.t1.to_string() + ": " + why;
         return;
       }
-      if (smooth && segment_open) acc.append(f.smoother_step());
-      if (inc.t1.ns() >= next_out_ns) {
+      const bool output_now = inc.t1.ns() >= next_out_ns;
+      // Smoother: close the run of steps at an update or an output epoch (eq. 12.13), else compose on.
+      if (smooth && (f.step_updated() || output_now)) {
+        if (segment_open) {
+          f.smoother_step(step);
+          acc.append(step);
+        } else {
+          f.drop_smoother_step();
+        }
+      }
+      if (output_now) {
         while (next_out_ns <= inc.t1.ns()) next_out_ns += out_period_ns;
         result.epochs.push_back(output(f.x().nav, f.P(), inc.t1, stance, last_used, last_rejected));
         last_used = last_rejected = 0;
         if (smooth) {
-          if (segment_open) segments.push_back(acc.take());
+          if (segment_open) segments.push(acc.take());
           segment_open = true;
           nominal_at_output.push_back(f.x());
         }
       }
+      if (in_.on_step) in_.on_step(inc.t1);
     };
 
     for (; sample_index < samples.size(); ++sample_index) {
@@ -384,23 +478,32 @@ class Runner {
       return make_error(fail_message);
     }
     if (smooth && !result.epochs.empty()) {
+      // Steps after the last closed run (no updates since) end the tail at the last step.
+      if (segment_open && f.run_open()) {
+        f.smoother_step(step);
+        acc.append(step);
+      }
       const RtsSegment tail = acc.take();
-      size_t bytes = tail.bytes() + nominal_at_output.size() * sizeof(ins::InsState);
-      for (const auto& s : segments) bytes += s.bytes();
-      const std::vector<RtsSmoothed> sm = rts_backward(segments, tail, f.P());
-      result.smoothed.reserve(result.epochs.size());
-      for (size_t k = 0; k < result.epochs.size(); ++k) {
+      const size_t bytes = segments.bytes() + nominal_at_output.size() * sizeof(ins::InsState);
+      result.smoothed.resize(result.epochs.size());
+      bool finite = true;
+      size_t bad = 0;
+      rts_backward(segments, tail, f.P(), [&](size_t k, const ErrorVector& dx, const ErrorMatrix& P) {
         // Smoothed state = forward nominal ⊞ smoothed error (eq. 12.12).
-        const ins::InsState xs = ins::boxplus(nominal_at_output[k], sm[k].dx, f.layout());
+        const ins::InsState xs = ins::boxplus(nominal_at_output[k], dx, f.layout());
         const EpochOutput& fwd = result.epochs[k];
-        EpochOutput e = output(xs.nav, sm[k].P, fwd.t, fwd.zupt, fwd.n_sats_used, fwd.n_sats_rejected);
-        if (!e.nav.p_eb_e.allFinite() || !sm[k].P.allFinite()) {
-          // The forward solution stands; the smoothed one is withheld and the reason reported.
-          sum.smoother_message = "smoother diverged at " + fwd.t.to_string() + ": non-finite smoothed state or covariance";
-          result.smoothed.clear();
-          return {};
+        result.smoothed[k] = output(xs.nav, P, fwd.t, fwd.zupt, fwd.n_sats_used, fwd.n_sats_rejected);
+        if (finite && (!xs.nav.p_eb_e.allFinite() || !P.allFinite())) {
+          finite = false;
+          bad = k;
         }
-        result.smoothed.push_back(e);
+      });
+      if (!finite) {
+        // The forward solution stands; the smoothed one is withheld and the reason reported.
+        sum.smoother_message =
+            "smoother diverged at " + result.epochs[bad].t.to_string() + ": non-finite smoothed state or covariance";
+        result.smoothed.clear();
+        return {};
       }
       sum.smoothed = true;
       sum.smoother_records = static_cast<long>(segments.size() + 1);
@@ -410,7 +513,7 @@ class Runner {
   }
 
   // One output epoch from a nominal navigation state and the covariance of its error (forward or smoothed).
-  EpochOutput output(const ins::NavState& nav, const MatrixXd& P, GpsTime t, bool zupt, int used, int rejected) const {
+  EpochOutput output(const ins::NavState& nav, const ErrorMatrix& P, GpsTime t, bool zupt, int used, int rejected) const {
     EpochOutput e;
     e.t = t;
     e.nav = nav;
@@ -444,9 +547,12 @@ class Runner {
     const Vector3d v = f.x().nav.v_eb_e;
     const bool zaru = o_.zaru && interval_start_stance && inc.dt_s > 0.0;
     const int m = zaru ? 6 : 3;
-    MatrixXd H = MatrixXd::Zero(m, n);
-    VectorXd r(m);
-    MatrixXd R = MatrixXd::Zero(m, m);
+    // Fixed capacity (6 rows): no heap allocation.
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, ins::kMaxErrorDim> H =
+        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, ins::kMaxErrorDim>::Zero(m, n);
+    Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 6, 1> r(m);
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, 6> R =
+        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, 6>::Zero(m, m);
     const Eigen::Matrix<double, 3, 6> J = zupt_jacobian(v, o_.zupt_form);
     H.block<3, 3>(0, ins::kVel.offset) = J.leftCols<3>();
     H.block<3, 3>(0, ins::kAtt.offset) = J.rightCols<3>();
@@ -474,18 +580,29 @@ class Runner {
   // stance onset that ends the step; state blocks: velocity and attitude (fusion/step_velocity.hpp).
   void step_velocity_update(Filter& f, const StepMeasurement& m, EngineSummary& sum) {
     const StepVelocityRows rows = step_velocity_rows(f.x().nav, m, o_.step_velocity);
-    MatrixXd H = MatrixXd::Zero(3, f.layout().dim());
+    Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, ins::kMaxErrorDim> H =
+        Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, ins::kMaxErrorDim>::Zero(3, f.layout().dim());
     H.block<3, 3>(0, ins::kVel.offset) = rows.J_dv_phi.leftCols<3>();
     H.block<3, 3>(0, ins::kAtt.offset) = rows.J_dv_phi.rightCols<3>();
     if (f.update(rows.residual, H, rows.cov_meas)) ++sum.step_velocity_updates;
   }
 
-  void count(std::map<std::string, long>& m, const std::string& key) { ++m[key]; }
+  // ++m[key] without constructing a std::string for keys already present (no heap allocation per epoch).
+  static void count(std::map<std::string, long>& m, const char* key) {
+    for (auto& [k, v] : m) {
+      if (k == key) {
+        ++v;
+        return;
+      }
+    }
+    ++m[key];
+  }
 
   // SD (or UD) pseudorange + Doppler update at rover epoch gi, processed at mechanization epoch t_proc >= epoch.
   void gnss_update(Filter& f, size_t gi, GpsTime t_proc, bool& clock_initialized, EngineSummary& sum, int& used_out,
                    int& rejected_out, std::vector<GnssRowRecord>* records) {
-    gnss::ObsEpoch re = (*in_.rover)[gi];
+    re_ = (*in_.rover)[gi];  // copy into a reused buffer (no allocation once its capacity suffices)
+    gnss::ObsEpoch& re = re_;
     if (in_.gnss_mask) {
       const size_t before = re.sats.size();
       in_.gnss_mask(re);
@@ -515,8 +632,11 @@ class Runner {
     const Vector3d p_a = p_imu + lever_e(p_imu);
     const Vector3d v_a = f.x().nav.v_eb_e;
     const Geodetic llh = geodetic_from_ecef(p_a);
-    std::vector<Row> rows;
-    std::vector<std::vector<double>> code_res_by_slot(o_.systems.size()), dop_res;
+    std::vector<Row>& rows = rows_;
+    rows.clear();
+    std::vector<std::vector<double>>& code_res_by_slot = code_res_by_slot_;
+    code_res_by_slot.resize(o_.systems.size());
+    for (auto& v : code_res_by_slot) v.clear();
     for (const gnss::SatObs& so : re.sats) {
       const int slot = system_slot(o_.systems, so.sat.system);
       if (slot < 0) continue;
@@ -563,7 +683,7 @@ class Runner {
       rc.sat = so.sat;
       rc.residual = code.residual;
       rc.sigma = sigma_c;
-      rc.h = Eigen::RowVectorXd::Zero(n);
+      rc.h = ins::ErrorRowVector::Zero(n);
       rc.h.segment<3>(ins::kPos.offset) = code.J_p;
       rc.h(f.clock_offset(slot)) = code.J_clock;
       code_res_by_slot[slot].push_back(code.residual);
@@ -574,7 +694,7 @@ class Runner {
         rd.doppler = true;
         rd.residual = rate.residual;
         rd.sigma = sigma_d;
-        rd.h = Eigen::RowVectorXd::Zero(n);
+        rd.h = ins::ErrorRowVector::Zero(n);
         rd.h.segment<3>(ins::kPos.offset) = rate.J_p;
         rd.h.segment<3>(ins::kVel.offset) = rate.J_v;
         rd.h(f.drift_offset()) = rate.J_drift;
@@ -598,7 +718,8 @@ class Runner {
       }
     }
     if (!clock_initialized) {
-      std::vector<double> d;
+      std::vector<double>& d = doppler_res_;
+      d.clear();
       for (const Row& r : rows) if (r.doppler) d.push_back(r.residual);
       if (!d.empty()) {
         const double med = median(d);
@@ -618,14 +739,16 @@ class Runner {
     const Eigen::Matrix3d C_vel = Ren * Vector3d(svh * svh, svh * svh, svv * svv).asDiagonal() * Ren.transpose();
     // w-test fault rejection, worst first (Baarda): w_i = (S^-1 nu)_i / sqrt((S^-1)_ii) against chi2(1, p).
     const double threshold = gnss::chi_square_quantile(o_.fault_probability, 1);
-    std::vector<int> active(rows.size());
+    std::vector<int>& active = active_;
+    active.resize(rows.size());
     for (size_t i = 0; i < rows.size(); ++i) active[i] = static_cast<int>(i);
     int rejected_code = 0;
-    auto build = [&](MatrixXd& H, VectorXd& r, MatrixXd& R) {
+    // Up to kMaxGnssRows rows in fixed-capacity matrices (no heap allocation), more in dynamic ones.
+    auto build = [&](auto& H, auto& r, auto& R) {
       const int m = static_cast<int>(active.size());
       H.resize(m, n);
       r.resize(m);
-      R = MatrixXd::Zero(m, m);
+      R.setZero(m, m);
       for (int i = 0; i < m; ++i) {
         const Row& a = rows[active[i]];
         H.row(i) = a.h;
@@ -644,15 +767,17 @@ class Runner {
         }
       }
     };
-    MatrixXd H, R;
-    VectorXd r;
     const size_t first_record = records ? records->size() : 0;
     bool first_test = true;
+    auto solve = [&](auto& H, auto& r, auto& R) {
+    using SMatrix = std::remove_reference_t<decltype(R)>;
+    using RVector = std::remove_reference_t<decltype(r)>;
     for (;;) {
       build(H, r, R);
-      const MatrixXd S = H * f.P() * H.transpose() + R;
-      const MatrixXd Sinv = S.ldlt().solve(MatrixXd::Identity(S.rows(), S.cols()));
-      const VectorXd a = Sinv * r;
+      SMatrix S = R;
+      S.noalias() += H * f.P() * H.transpose();
+      const SMatrix Sinv = S.ldlt().solve(SMatrix::Identity(S.rows(), S.cols()));
+      const RVector a = Sinv * r;
       if (records && first_test) {
         // Baarda's internal reliability: MDB_i = (k + z_0.8) / sqrt((S^-1)_ii), k = sqrt(threshold) (docs/fusion.md eq. 6.4).
         constexpr double kZPower80 = 0.8416;
@@ -691,12 +816,24 @@ class Runner {
       }
       active.erase(active.begin() + worst);
     }
+    };
+    if (static_cast<int>(rows.size()) <= kMaxGnssRows) {
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxGnssRows, ins::kMaxErrorDim> H;
+      Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxGnssRows, 1> r;
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxGnssRows, kMaxGnssRows> R;
+      solve(H, r, R);
+      if (f.update(r, H, R)) ++sum.gnss_epochs_used;
+    } else {
+      MatrixXd H, R;
+      VectorXd r;
+      solve(H, r, R);
+      if (f.update(r, H, R)) ++sum.gnss_epochs_used;
+    }
     int used_code = 0;
     for (int i : active) {
       if (rows[i].doppler) count(sum.doppler_used_rejected, "used");
       else { count(sum.code_used_rejected, "used"); ++used_code; }
     }
-    if (f.update(r, H, R)) ++sum.gnss_epochs_used;
     used_out = used_code;
     rejected_out = rejected_code;
   }
@@ -708,6 +845,12 @@ class Runner {
   std::vector<gnss::BaseMatch> matches_;
   bool sd_ = false;
   FrameYaw frame_;
+  // Per-epoch buffers, reused (their capacity persists: no heap allocation after the first epochs).
+  gnss::ObsEpoch re_;
+  std::vector<Row> rows_;
+  std::vector<std::vector<double>> code_res_by_slot_;
+  std::vector<double> doppler_res_;
+  std::vector<int> active_;
 };
 
 // 2D rigid fit (rotation about the vertical + translation) of src onto dst (ENU); returns the rotation angle

@@ -84,6 +84,9 @@ struct EngineInputs {
   const std::vector<gnss::ObsEpoch>* base = nullptr;  ///< optional (SD)
   /// GNSS epochs whose time is in this set are skipped (outage masks); satellites of partial outages removed.
   std::function<void(gnss::ObsEpoch&)> gnss_mask;
+  /// Test hook: called at the end of every mechanization step with the step's end time (GPST), after its updates
+  /// and outputs (tests/fusion/test_allocations.cpp counts heap allocations between calls).
+  std::function<void(GpsTime)> on_step;
 };
 
 /// One output epoch of the forward solution.

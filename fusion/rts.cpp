@@ -4,65 +4,124 @@
 
 namespace pednav::fusion {
 
-using Eigen::MatrixXd;
-using Eigen::VectorXd;
-
-RtsStep rts_step(const MatrixXd& P_post, const MatrixXd& Phi, const MatrixXd& P_prior, const MatrixXd& A,
-                 const VectorXd& d) {
-  // C = P_post Φᵀ P_prior⁻¹ (docs/fusion.md eq. 12.4), from P_prior Cᵀ = Φ P_post. The error state mixes metres,
-  // radians and an unconverged clock (variance up to 1e12 m²), so the solve is Jacobi-scaled: with
-  // D = diag(P_prior)^(-1/2), (D P_prior D)(D⁻¹ Cᵀ) = D Φ P_post.
-  const MatrixXd PhiP = Phi * P_post;
-  const VectorXd D = P_prior.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
-  const MatrixXd scaled = D.asDiagonal() * P_prior * D.asDiagonal();
-  const Eigen::LDLT<MatrixXd> ldlt(scaled);
-  const MatrixXd Ct = D.asDiagonal() * ldlt.solve(D.asDiagonal() * PhiP);
-  const MatrixXd C = Ct.transpose();
+RtsStep rts_step(const ErrorMatrix& P_post, const ErrorMatrix& Phi, const ErrorMatrix& P_prior, const ErrorMatrix& A,
+                 const ErrorVector& d) {
   RtsStep s;
-  s.G = C * A;                                   // eq. 12.7
-  s.g = C * d;                                   // eq. 12.7
-  s.Sigma = P_post - C * PhiP;                   // eq. 12.6: P_post − C P_prior Cᵀ = P_post − C Φ P_post
-  s.Sigma = 0.5 * (s.Sigma + s.Sigma.transpose());
+  rts_step(P_post, Phi, P_prior, A, d, s);
   return s;
 }
 
+void rts_step(const ErrorMatrix& P_post, const ErrorMatrix& Phi, const ErrorMatrix& P_prior, const ErrorMatrix& A,
+              const ErrorVector& d, RtsStep& s) {
+  ErrorMatrix PhiP;
+  PhiP.noalias() = Phi * P_post;
+  rts_step(P_post, Phi, P_prior, A, d, PhiP, s);
+}
+
+void rts_step(const ErrorMatrix& P_post, const ErrorMatrix& /*Phi*/, const ErrorMatrix& P_prior, const ErrorMatrix& A,
+              const ErrorVector& d, const ErrorMatrix& PhiP, RtsStep& s) {
+  // C = P_post Φᵀ P_prior⁻¹ (docs/fusion.md eq. 12.4), from P_prior Cᵀ = Φ P_post. The error state mixes metres,
+  // radians and an unconverged clock (variance up to 1e12 m²), so the solve is Jacobi-scaled: with
+  // D = diag(P_prior)^(-1/2), (D P_prior D)(D⁻¹ Cᵀ) = D Φ P_post.
+  const ErrorVector D = P_prior.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+  const ErrorMatrix scaled = D.asDiagonal() * P_prior * D.asDiagonal();
+  const Eigen::LDLT<ErrorMatrix> ldlt(scaled);
+  const ErrorMatrix Ct = D.asDiagonal() * ldlt.solve(D.asDiagonal() * PhiP);
+  const ErrorMatrix C = Ct.transpose();
+  // G = C A (eq. 12.7). A is the identity but for the columns the form-D re-expression touched (eq. 12.3): those
+  // columns are multiplied, the others copied (C e_j = column j of C exactly).
+  s.G = C;
+  const int n = static_cast<int>(A.cols());
+  for (int j = 0; j < n; ++j) {
+    bool unit = true;
+    for (int i = 0; i < n && unit; ++i) unit = A(i, j) == (i == j ? 1.0 : 0.0);
+    if (!unit) s.G.col(j).noalias() = C * A.col(j);
+  }
+  s.g.noalias() = C * d;                         // eq. 12.7
+  s.Sigma = P_post;                              // eq. 12.6: P_post − C P_prior Cᵀ = P_post − C Φ P_post
+  s.Sigma.noalias() -= C * PhiP;
+  s.Sigma = 0.5 * (s.Sigma + s.Sigma.transpose()).eval();
+}
+
 void RtsAccumulator::reset(int n) {
-  seg_.M = MatrixXd::Identity(n, n);
-  seg_.m = VectorXd::Zero(n);
-  seg_.S = MatrixXd::Zero(n, n);
+  seg_.M.setIdentity(n, n);
+  seg_.m.setZero(n);
+  seg_.S.setZero(n, n);
   steps_ = 0;
 }
 
 void RtsAccumulator::append(const RtsStep& step) {
   // ŝ_a = M ŝ_j + m with ŝ_j = G ŝ_{j+1} + g  ⇒  M ← M G, m ← m + M g; P likewise: S ← S + M Σ Mᵀ (eq. 12.9).
-  seg_.m += seg_.M * step.g;
-  seg_.S += seg_.M * step.Sigma * seg_.M.transpose();
-  seg_.M = seg_.M * step.G;
+  seg_.m.noalias() += seg_.M * step.g;
+  tmp_.noalias() = seg_.M * step.Sigma;
+  seg_.S.noalias() += tmp_ * seg_.M.transpose();
+  tmp_.noalias() = seg_.M * step.G;
+  seg_.M = tmp_;
   ++steps_;
 }
 
 RtsSegment RtsAccumulator::take() {
-  RtsSegment out = std::move(seg_);
-  out.S = 0.5 * (out.S + out.S.transpose());
+  RtsSegment out = seg_;
+  out.S = 0.5 * (out.S + out.S.transpose()).eval();
   reset(static_cast<int>(out.M.rows()));
   return out;
 }
 
-std::vector<RtsSmoothed> rts_backward(const std::vector<RtsSegment>& segments, const RtsSegment& tail,
-                                      const MatrixXd& P_last) {
-  std::vector<RtsSmoothed> out(segments.size() + 1);
-  // At the last step the smoothed error is the filtered one, zero after the closed-loop reset (eq. 12.10).
-  RtsSmoothed cur;
-  cur.dx = tail.m;
-  cur.P = tail.S + tail.M * P_last * tail.M.transpose();
-  out.back() = cur;
-  for (size_t i = segments.size(); i-- > 0;) {
-    const RtsSegment& s = segments[i];
-    cur.dx = s.M * cur.dx + s.m;
-    cur.P = s.S + s.M * cur.P * s.M.transpose();
-    cur.P = 0.5 * (cur.P + cur.P.transpose());
-    out[i] = cur;
+void RtsStore::push(const RtsSegment& s) {
+  const int n = n_;
+  for (int c = 0; c < n; ++c) {
+    for (int r = 0; r < n; ++r) data_.push_back(s.M(r, c));
   }
+  for (int r = 0; r < n; ++r) data_.push_back(s.m(r));
+  for (int c = 0; c < n; ++c) {
+    for (int r = 0; r <= c; ++r) data_.push_back(s.S(r, c));
+  }
+}
+
+void RtsStore::get(size_t i, RtsSegment& out) const {
+  const int n = n_;
+  const double* p = data_.data() + i * record_doubles();
+  out.M.resize(n, n);
+  out.m.resize(n);
+  out.S.resize(n, n);
+  for (int c = 0; c < n; ++c) {
+    for (int r = 0; r < n; ++r) out.M(r, c) = *p++;
+  }
+  for (int r = 0; r < n; ++r) out.m(r) = *p++;
+  for (int c = 0; c < n; ++c) {
+    for (int r = 0; r <= c; ++r) out.S(r, c) = out.S(c, r) = *p++;
+  }
+}
+
+void rts_backward(const RtsStore& store, const RtsSegment& tail, const ErrorMatrix& P_last,
+                  const std::function<void(size_t, const ErrorVector&, const ErrorMatrix&)>& visit) {
+  // At the last step the smoothed error is the filtered one, zero after the closed-loop reset (eq. 12.10).
+  ErrorVector dx = tail.m;
+  ErrorMatrix P = tail.S + tail.M * P_last * tail.M.transpose();
+  visit(store.size(), dx, P);
+  RtsSegment s;
+  ErrorMatrix tmp;
+  for (size_t i = store.size(); i-- > 0;) {
+    store.get(i, s);
+    dx = (s.M * dx + s.m).eval();
+    tmp.noalias() = s.M * P;
+    P = s.S;
+    P.noalias() += tmp * s.M.transpose();
+    P = 0.5 * (P + P.transpose()).eval();
+    visit(i, dx, P);
+  }
+}
+
+std::vector<RtsSmoothed> rts_backward(const std::vector<RtsSegment>& segments, const RtsSegment& tail,
+                                      const ErrorMatrix& P_last) {
+  RtsStore store(static_cast<int>(tail.M.rows()));
+  store.reserve(segments.size());
+  for (const RtsSegment& s : segments) store.push(s);
+  std::vector<RtsSmoothed> out(segments.size() + 1);
+  rts_backward(store, tail, P_last, [&](size_t i, const ErrorVector& dx, const ErrorMatrix& P) {
+    out[i].dx = dx;
+    out[i].P = P;
+  });
   return out;
 }
 

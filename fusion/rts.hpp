@@ -1,38 +1,52 @@
 // Rauch-Tung-Striebel smoothing of a closed-loop (feedback) error-state filter, as pure linear algebra: no INS,
-// no I/O. The forward filter hands over, per mechanization step, its posterior covariance, the transition and the
-// prior covariance of the next step, and how that next step's updates moved the nominal state; the accumulator
-// composes the per-step backward recursion between output epochs so that only one record per output epoch is
-// stored (docs/fusion.md §12 "Smoother", eqs. 12.1-12.12).
+// no I/O. The forward filter hands over, per mechanization step (or per run of steps without updates, eq. 12.13),
+// its posterior covariance, the transition and the prior covariance of the next step, and how that next step's
+// updates moved the nominal state; the accumulator composes the per-step backward recursion between output epochs
+// so that only one record per output epoch is stored (docs/fusion.md §12 "Smoother", eqs. 12.1-12.13; memory and
+// speed: docs/performance.md). Working matrices have a fixed capacity (ins::ErrorMatrix): no heap allocation per
+// step; the stored records are packed doubles in one growing array.
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
+#include <functional>
 #include <vector>
+
+#include "ins/error_state.hpp"
 
 namespace pednav::fusion {
 
+using ins::ErrorMatrix;
+using ins::ErrorVector;
+
 /// Backward map of one step j -> j+1 (docs/fusion.md eq. 12.7): ŝ_j = G ŝ_{j+1} + g,  P_s,j = Σ + G P_s,{j+1} Gᵀ.
 struct RtsStep {
-  Eigen::MatrixXd G;      ///< C_j A_{j+1}  (n x n)
-  Eigen::VectorXd g;      ///< C_j d_{j+1}  (n)
-  Eigen::MatrixXd Sigma;  ///< P_j|j − C_j P_{j+1|j} C_jᵀ  (n x n, symmetric)
+  ErrorMatrix G;      ///< C_j A_{j+1}  (n x n)
+  ErrorVector g;      ///< C_j d_{j+1}  (n)
+  ErrorMatrix Sigma;  ///< P_j|j − C_j P_{j+1|j} C_jᵀ  (n x n, symmetric)
 };
 
 /// One RTS step of the closed-loop filter (docs/fusion.md eqs. 12.4-12.7).
 /// P_post: covariance of the error of the nominal state at step j after all of step j's updates [state units²];
-/// Phi: error transition j -> j+1 (resets folded in); P_prior: Φ P_post Φᵀ + Q_d, the covariance before step
-/// j+1's updates; A, d: the error before step j+1's updates in terms of the error after them, δx⁻ = A δx + d
-/// (d = the corrections fed back into the nominal state in step j+1, A = the covariance re-expressions).
-RtsStep rts_step(const Eigen::MatrixXd& P_post, const Eigen::MatrixXd& Phi, const Eigen::MatrixXd& P_prior,
-                 const Eigen::MatrixXd& A, const Eigen::VectorXd& d);
+/// Phi: error transition j -> j+1 (resets folded in; or the product of the transitions of a run of steps without
+/// updates, eq. 12.13); P_prior: Φ P_post Φᵀ + Q_d, the covariance before step j+1's updates; A, d: the error
+/// before step j+1's updates in terms of the error after them, δx⁻ = A δx + d (d = the corrections fed back into
+/// the nominal state in step j+1, A = the covariance re-expressions).
+RtsStep rts_step(const ErrorMatrix& P_post, const ErrorMatrix& Phi, const ErrorMatrix& P_prior, const ErrorMatrix& A,
+                 const ErrorVector& d);
+/// The same, written into `out` (no copy of the result).
+void rts_step(const ErrorMatrix& P_post, const ErrorMatrix& Phi, const ErrorMatrix& P_prior, const ErrorMatrix& A,
+              const ErrorVector& d, RtsStep& out);
+/// The same with Φ P_post already computed (PhiP; the filter has it from its covariance prediction).
+void rts_step(const ErrorMatrix& P_post, const ErrorMatrix& Phi, const ErrorMatrix& P_prior, const ErrorMatrix& A,
+              const ErrorVector& d, const ErrorMatrix& PhiP, RtsStep& out);
 
 /// Composition of consecutive steps between two output epochs a < b (docs/fusion.md eq. 12.9):
 /// ŝ_a = M ŝ_b + m,  P_s,a = S + M P_s,b Mᵀ.
 struct RtsSegment {
-  Eigen::MatrixXd M;
-  Eigen::VectorXd m;
-  Eigen::MatrixXd S;
-  /// Bytes of heap storage of this record (for memory reporting).
-  size_t bytes() const { return sizeof(double) * static_cast<size_t>(M.size() + m.size() + S.size()); }
+  ErrorMatrix M;
+  ErrorVector m;
+  ErrorMatrix S;
 };
 
 /// Composes steps forward in time (M ← M G, m ← m + M g, S ← S + M Σ Mᵀ) into one segment per output epoch.
@@ -51,7 +65,35 @@ class RtsAccumulator {
 
  private:
   RtsSegment seg_;
+  ErrorMatrix tmp_;
   int steps_ = 0;
+};
+
+/// The stored segments, packed: per record M (n², column-major), m (n) and the upper triangle of the symmetric S
+/// (n(n+1)/2), all double, in one array (one allocation growing geometrically, or none after reserve()).
+/// For n = 17: 459 doubles = 3672 B per output epoch (docs/performance.md).
+class RtsStore {
+ public:
+  explicit RtsStore(int n = 0) : n_(n) {}
+  /// Pre-size for `records` records (no reallocation while pushing up to that many).
+  void reserve(size_t records) { data_.reserve(records * record_doubles()); }
+  /// Append one segment (its dimension must be n).
+  void push(const RtsSegment& s);
+  /// Segment i (0 = first).
+  void get(size_t i, RtsSegment& out) const;
+  size_t size() const { return n_ == 0 ? 0 : data_.size() / record_doubles(); }
+  int dim() const { return n_; }
+  /// Doubles per record: n² + n + n(n+1)/2.
+  size_t record_doubles() const {
+    const size_t n = static_cast<size_t>(n_);
+    return n * n + n + n * (n + 1) / 2;
+  }
+  /// Bytes of the records held (for memory reporting).
+  size_t bytes() const { return data_.size() * sizeof(double); }
+
+ private:
+  int n_;
+  std::vector<double> data_;
 };
 
 /// Smoothed error estimate and covariance at each output epoch.
@@ -60,10 +102,14 @@ struct RtsSmoothed {
   Eigen::MatrixXd P;   ///< its covariance
 };
 
-/// Backward pass (docs/fusion.md eq. 12.10): segments[i] maps output epoch i+1 onto output epoch i, tail maps the
+/// Backward pass (docs/fusion.md eq. 12.10): store record i maps output epoch i+1 onto output epoch i, tail maps the
 /// last step onto the last output epoch, P_last is the filter covariance at the last step (where the smoothed and
-/// filtered solutions coincide, ŝ = 0). Returns one entry per output epoch (segments.size() + 1).
+/// filtered solutions coincide, ŝ = 0). Calls visit(i, ŝ_i, P_s,i) for i = store.size() down to 0.
+void rts_backward(const RtsStore& store, const RtsSegment& tail, const ErrorMatrix& P_last,
+                  const std::function<void(size_t, const ErrorVector&, const ErrorMatrix&)>& visit);
+
+/// The same over segments held in a vector; returns one entry per output epoch (segments.size() + 1).
 std::vector<RtsSmoothed> rts_backward(const std::vector<RtsSegment>& segments, const RtsSegment& tail,
-                                      const Eigen::MatrixXd& P_last);
+                                      const ErrorMatrix& P_last);
 
 }  // namespace pednav::fusion

@@ -17,6 +17,14 @@
 
 namespace pednav::ins {
 
+/// Largest error-state dimension (15 core + scale factors + clocks + ...): the capacity of the matrix types below.
+inline constexpr int kMaxErrorDim = 32;
+/// Error-state vector and matrix with a compile-time capacity of kMaxErrorDim: sized at run time, stored inline, so
+/// the per-epoch path never allocates on the heap (issue 10; docs/performance.md).
+using ErrorVector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxErrorDim, 1>;
+using ErrorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxErrorDim, kMaxErrorDim>;
+using ErrorRowVector = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxErrorDim>;
+
 /// A contiguous block of the error state.
 struct Block {
   int offset;
@@ -33,7 +41,8 @@ inline constexpr const char* kScaleAccBlock = "scale_acc";
 class ErrorStateLayout {
  public:
   ErrorStateLayout();
-  /// Register an optional block of `dim` states at the end; error if the name is taken or dim < 1.
+  /// Register an optional block of `dim` states at the end; error if the name is taken, dim < 1 or the total would
+  /// exceed kMaxErrorDim.
   Expected<Block> add(const std::string& name, int dim);
   /// The block of a registered name (core names: "pos", "vel", "att", "bias_gyro", "bias_acc").
   std::optional<Block> find(const std::string& name) const;
@@ -54,15 +63,15 @@ struct InsState {
 };
 
 /// x ⊞ δx over the INS blocks (core + scale factors if registered); other blocks of δx are ignored.
-InsState boxplus(const InsState& x, const Eigen::VectorXd& dx, const ErrorStateLayout& layout);
+InsState boxplus(const InsState& x, const Eigen::Ref<const Eigen::VectorXd>& dx, const ErrorStateLayout& layout);
 /// δx = a ⊟ b such that a = b ⊞ δx (INS blocks; other blocks zero). φ = log(R_a R_b^T).
 Eigen::VectorXd boxminus(const InsState& a, const InsState& b, const ErrorStateLayout& layout);
 
 /// Continuous error model  δẋ = F δx + G w,  E[w w^T] = Q δ(t). w = [n_g, n_a, w_bg, w_ba, (w_sg), (w_sa)].
 struct ContinuousErrorModel {
-  Eigen::MatrixXd F;  ///< dim x dim [1/s]
-  Eigen::MatrixXd G;  ///< dim x nw
-  Eigen::MatrixXd Q;  ///< nw x nw power spectral densities (diagonal)
+  ErrorMatrix F;  ///< dim x dim [1/s]
+  ErrorMatrix G;  ///< dim x nw
+  ErrorMatrix Q;  ///< nw x nw power spectral densities (diagonal)
 };
 
 /// F, G, Q at the nominal state: attitude R_e_b, position p_eb_e [m] (ECEF), mean specific force f_ib_b
@@ -81,8 +90,8 @@ enum class QdMethod {
 
 /// Discrete model over Δt: Φ = I + FΔt + 1/2 (FΔt)^2 and Qd.
 struct DiscreteErrorModel {
-  Eigen::MatrixXd Phi;
-  Eigen::MatrixXd Qd;
+  ErrorMatrix Phi;
+  ErrorMatrix Qd;
 };
 
 /// Discretize a continuous model over dt_s [s].

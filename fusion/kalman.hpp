@@ -1,0 +1,65 @@
+// The EKF covariance prediction and Joseph-form update of the forward engine on fixed-capacity matrices
+// (ins::ErrorMatrix: sized at run time, stored inline): no heap allocation when the measurement matrices have a
+// fixed capacity too (docs/performance.md). Used by fusion/engine.cpp and the benchmarks in bench/.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "core/column_sparse.hpp"
+#include "ins/error_state.hpp"
+
+namespace pednav::fusion {
+
+/// P ← Φ P Φᵀ + Q_d, symmetrized (Groves 2013 eq. 3.15); tmp is scratch space.
+/// P: error covariance [state units²]; Phi: error transition over the step; Qd: discrete process noise.
+inline void covariance_predict(ins::ErrorMatrix& P, const ins::ErrorMatrix& Phi, const ins::ErrorMatrix& Qd,
+                               ins::ErrorMatrix& tmp) {
+  tmp.noalias() = Phi * P;
+  P = Qd;
+  P.noalias() += tmp * Phi.transpose();
+  P = 0.5 * (P + P.transpose()).eval();
+}
+
+/// The same with Φ given by its nonzeros (Φ of the INS error model is about half zeros): P ← Φ P Φᵀ + Q_d.
+inline void covariance_predict(ins::ErrorMatrix& P, const ColumnSparse<ins::kMaxErrorDim>& Phi,
+                               const ins::ErrorMatrix& Qd, ins::ErrorMatrix& tmp) {
+  Phi.times(P, tmp);
+  P = Qd;
+  Phi.add_times_transposed(tmp, P);
+  P = 0.5 * (P + P.transpose()).eval();
+}
+
+/// Joseph-form Kalman update (Groves 2013 eqs. 3.18, 3.22): K = P Hᵀ (H P Hᵀ + R)⁻¹, dx = K r,
+/// P ← (I − K H) P (I − K H)ᵀ + K R Kᵀ, symmetrized. r: residuals (measured − predicted) [measurement units],
+/// H: Jacobian w.r.t. the error state (m × n), R: measurement noise covariance (m × m). Returns false (P and dx
+/// untouched) if H P Hᵀ + R is not positive definite. With fixed-capacity H, r and R nothing is allocated.
+template <typename MatH, typename VecR, typename MatR>
+bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR& R, ins::ErrorVector& dx,
+                   ins::ErrorMatrix& tmp) {
+  using ColsMatrix = Eigen::Matrix<double, Eigen::Dynamic, MatH::RowsAtCompileTime, Eigen::ColMajor,
+                                   ins::kMaxErrorDim, MatH::MaxRowsAtCompileTime>;
+  using SMatrix = Eigen::Matrix<double, MatH::RowsAtCompileTime, MatH::RowsAtCompileTime, Eigen::ColMajor,
+                                MatH::MaxRowsAtCompileTime, MatH::MaxRowsAtCompileTime>;
+  ColsMatrix PHt;
+  PHt.noalias() = P * H.transpose();
+  SMatrix S = R;
+  S.noalias() += H * PHt;
+  const Eigen::LDLT<SMatrix> ldlt(S);
+  if (ldlt.info() != Eigen::Success) return false;
+  const ColsMatrix K = ldlt.solve(PHt.transpose()).transpose();
+  dx.noalias() = K * r;
+  // (I − K H) P (I − K H)ᵀ without forming I − K H (m ≪ n): T = P − K (H P), then T − (T Hᵀ) Kᵀ; H P = (P Hᵀ)ᵀ
+  // as P is symmetric. Four n×m×n products instead of two n×n×n and one n×m×n.
+  tmp = P;
+  tmp.noalias() -= K * PHt.transpose();
+  const ColsMatrix THt = tmp * H.transpose();
+  P = tmp;
+  P.noalias() -= THt * K.transpose();
+  const ColsMatrix KR = K * R;
+  P.noalias() += KR * K.transpose();
+  P = 0.5 * (P + P.transpose()).eval();
+  return true;
+}
+
+}  // namespace pednav::fusion
