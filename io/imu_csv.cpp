@@ -15,6 +15,8 @@ namespace {
 
 constexpr double kG0 = 9.80665;
 constexpr double kGpsMinusUnixEpoch_s = 315964800.0;  // 1980-01-06 - 1970-01-01 (no leap seconds: GPST scale)
+// Largest |GPST| of a sample [ns]: 4e18 ns = 126 years after 1980; differences of two such times fit in int64.
+constexpr double kMaxAbsTime_ns = 4e18;
 
 std::string num(double v, const char* f = "%.6g") {
   char b[64];
@@ -147,14 +149,22 @@ Expected<ImuLog> parse_imu_csv(const char* data, size_t size, const std::string&
       continue;
     }
     double t_s = use_time ? vals[0] * fmt.time_scale_s : static_cast<double>(index) / fmt.index_rate_hz;
-    GpsTime t;
+    double t_ns = 0.0;  // GPST nanoseconds, in double first: a garbage time stamp must not overflow the integer count
     if (fmt.time_base == "gps_sow") {
-      t = GpsTime::from_ns(static_cast<int64_t>(fmt.gps_week) * kNsPerWeek + std::llround(t_s * 1e9));
+      t_ns = static_cast<double>(fmt.gps_week) * static_cast<double>(kNsPerWeek) + t_s * 1e9;
     } else if (fmt.time_base == "gpst_unix") {
-      t = GpsTime::from_ns(std::llround((t_s - kGpsMinusUnixEpoch_s) * 1e9));
+      t_ns = (t_s - kGpsMinusUnixEpoch_s) * 1e9;
     } else {
-      t = GpsTime::from_ns(std::llround(start_ns + t_s * 1e9));
+      t_ns = start_ns + t_s * 1e9;
     }
+    if (!(std::abs(t_ns) < kMaxAbsTime_ns)) {
+      ++rep.bad_rows;
+      if (!rep.first_bad_line) rep.first_bad_line = line;
+      if (first_bad_reason.empty()) first_bad_reason = "time " + num(t_s) + " s is out of range";
+      p = next;
+      continue;
+    }
+    const GpsTime t = GpsTime::from_ns(std::llround(t_ns));
     const Eigen::Vector3d g_s(vals[1] * gs * fmt.gyro_signs(0), vals[2] * gs * fmt.gyro_signs(1),
                               vals[3] * gs * fmt.gyro_signs(2));
     const Eigen::Vector3d a_s(vals[4] * as * fmt.accel_signs(0), vals[5] * as * fmt.accel_signs(1),

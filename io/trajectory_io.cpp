@@ -63,6 +63,17 @@ Expected<void> push_point(TrajectoryFile& f, const std::string& path, int line, 
   return {};
 }
 
+// Time fields a GpsTime can hold without overflow and a receiver can produce (fuzzing found a year of 2e3 giving a
+// signed overflow in the nanosecond count): GPS weeks 0..9999, calendar years 1980..2199.
+constexpr int kMaxGpsWeek = 9999;
+bool valid_week_tow(double week, double tow_s) {
+  return week >= 0 && week <= kMaxGpsWeek && week == std::floor(week) && tow_s >= -604800.0 && tow_s <= 2 * 604800.0;
+}
+bool valid_calendar(const CalendarTime& c) {
+  return c.year >= 1980 && c.year < 2200 && c.month >= 1 && c.month <= 12 && c.day >= 1 && c.day <= 31 && c.hour >= 0 &&
+         c.hour <= 24 && c.minute >= 0 && c.minute <= 59 && c.second >= 0.0 && c.second < 61.0;
+}
+
 bool nmea_checksum_ok(const std::string& s) {
   const auto star = s.find('*');
   if (s.empty() || s[0] != '$' || star == std::string::npos || star + 3 > s.size()) return false;
@@ -102,7 +113,8 @@ Expected<TrajectoryFile> read_nmea_gga(const std::string& path, const Trajectory
   f.format = "nmea";
   // UTC date: from RMC (field 9, ddmmyy) or the option; advances when the GGA time of day wraps.
   int year = 0, month = 0, day = 0;
-  if (!options.nmea_date.empty() && std::sscanf(options.nmea_date.c_str(), "%d-%d-%d", &year, &month, &day) != 3) {
+  if (!options.nmea_date.empty() && (std::sscanf(options.nmea_date.c_str(), "%d-%d-%d", &year, &month, &day) != 3 ||
+                                      !valid_calendar({year, month, day, 0, 0, 0.0}))) {
     return make_error("nmea date '" + options.nmea_date + "': expected YYYY-MM-DD");
   }
   double last_sod = -1.0;
@@ -125,7 +137,7 @@ Expected<TrajectoryFile> read_nmea_gga(const std::string& path, const Trajectory
       // The first RMC date is the session's UTC date; later days follow from the GGA time-of-day wrap.
       if (year == 0 && fields.size() > 9 && fields[9].size() == 6) {
         int d = 0, m = 0, y = 0;
-        if (std::sscanf(fields[9].c_str(), "%2d%2d%2d", &d, &m, &y) == 3) {
+        if (std::sscanf(fields[9].c_str(), "%2d%2d%2d", &d, &m, &y) == 3 && valid_calendar({2000 + y, m, d, 0, 0, 0.0})) {
           year = 2000 + y;
           month = m;
           day = d;
@@ -158,6 +170,9 @@ Expected<TrajectoryFile> read_nmea_gga(const std::string& path, const Trajectory
     }
     const double hh = std::floor(hhmmss / 10000.0), mm = std::floor((hhmmss - hh * 10000.0) / 100.0);
     const double ss = hhmmss - hh * 10000.0 - mm * 100.0;
+    if (!(hhmmss >= 0.0) || hh > 23 || mm > 59 || ss >= 61.0) {
+      return make_error(fmt::format("{}:{}: GGA time '{}' is not hhmmss.ss", path, n, fields[1]));
+    }
     const double sod = hh * 3600.0 + mm * 60.0 + ss;
     CalendarTime c{year, month, day, 0, 0, 0.0};
     GpsTime midnight = GpsTime::from_utc(c);
@@ -208,13 +223,13 @@ Expected<TrajectoryFile> read_rtklib_pos(const std::string& path) {
     if (a.find('/') != std::string::npos) {
       CalendarTime c;
       if (std::sscanf(a.c_str(), "%d/%d/%d", &c.year, &c.month, &c.day) != 3 ||
-          std::sscanf(b.c_str(), "%d:%d:%lf", &c.hour, &c.minute, &c.second) != 3) {
+          std::sscanf(b.c_str(), "%d:%d:%lf", &c.hour, &c.minute, &c.second) != 3 || !valid_calendar(c)) {
         return make_error(fmt::format("{}:{}: expected 'YYYY/MM/DD HH:MM:SS.SSS' time, got '{} {}'", path, n, a, b));
       }
       t = utc ? GpsTime::from_utc(c) : GpsTime::from_calendar_gpst(c);
     } else {
       double week = 0, tow = 0;
-      if (!to_double(a, week) || !to_double(b, tow)) {
+      if (!to_double(a, week) || !to_double(b, tow) || !valid_week_tow(week, tow)) {
         return make_error(fmt::format("{}:{}: expected 'week tow' or a calendar time, got '{} {}'", path, n, a, b));
       }
       t = GpsTime::from_week_tow(static_cast<int>(week), tow);
@@ -282,9 +297,9 @@ Expected<TrajectoryFile> read_trajectory_csv(const std::string& path) {
     ++f.lines;
     if (trim(line).empty()) continue;
     const auto cells = split(line, ',');
-    auto cell = [&](int c) -> std::string { return c < static_cast<int>(cells.size()) ? cells[c] : std::string(); };
+    auto cell = [&](int c) -> std::string { return c >= 0 && c < static_cast<int>(cells.size()) ? cells[c] : std::string(); };
     double week = 0, tow = 0;
-    if (c_week >= 0) {
+    if (c_week >= 0 && c_tow >= 0) {
       if (!to_double(cell(c_week), week) || !to_double(cell(c_tow), tow)) {
         return make_error(fmt::format("{}:{}: expected numbers in gps_week, gps_tow_s", path, n));
       }
@@ -294,6 +309,9 @@ Expected<TrajectoryFile> read_trajectory_csv(const std::string& path) {
         return make_error(fmt::format("{}:{}: expected numbers in GpsCycle, GpsWeek, GpsToW [s]", path, n));
       }
       week = cycle * 1024 + w1024;
+    }
+    if (!valid_week_tow(week, tow)) {
+      return make_error(fmt::format("{}:{}: time (GPS week {}, {} s) is out of range (weeks 0..{})", path, n, week, tow, kMaxGpsWeek));
     }
     double v[3];
     bool ok = true;

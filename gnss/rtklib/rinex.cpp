@@ -23,6 +23,17 @@ namespace {
 
 constexpr int64_t kGpsEpochUnix_s = 315964800;  // 1980-01-06 00:00:00 in the gtime_t (Unix-like) count
 
+// Times a record may carry: from the GPS epoch (1980-01-06) to 4e9 s later (year 2106), so that differences fit in
+// int64 ns. A RINEX date far outside (fuzzing found an ephemeris week of 240101) would overflow the nanosecond count;
+// RTKLIB maps an epoch year outside 1970..2099 to 1970-01-01, before the GPS epoch (docs/robustness.md).
+constexpr int64_t kMaxGpsTime_s = 4'000'000'000;
+
+bool in_range(gtime_t t) {
+  const int64_t whole = static_cast<int64_t>(t.time) - kGpsEpochUnix_s;
+  return whole >= 0 && whole < kMaxGpsTime_s && std::isfinite(t.sec) && std::abs(t.sec) < 2.0;
+}
+
+// Call only for in_range(t).
 GpsTime from_gtime(gtime_t t) {
   const int64_t whole = static_cast<int64_t>(t.time) - kGpsEpochUnix_s;
   return GpsTime::from_ns(whole * kNsPerS + static_cast<int64_t>(std::llround(t.sec * 1e9)));
@@ -137,6 +148,7 @@ Expected<ObsData> read_rinex_obs(const std::string& path, const SystemSelection&
 
   for (int i = 0; i < obs->n; ++i) {
     const obsd_t& d = obs->data[i];
+    if (!in_range(d.time)) continue;  // a garbage date: dropped
     const GpsTime t = from_gtime(d.time);
     if (out.epochs.empty() || std::abs(t - out.epochs.back().time) > 1e-6) {
       out.epochs.push_back(ObsEpoch{t, {}});
@@ -160,6 +172,7 @@ Expected<ObsData> read_rinex_obs(const std::string& path, const SystemSelection&
     }
     out.epochs.back().sats.push_back(so);
   }
+  if (out.epochs.empty()) return make_error(path + ": no usable observation epoch");
   out.stats.epochs_read = static_cast<int>(out.epochs.size());
   prescan_rinex3(path, out.stats);
   return out;
@@ -180,6 +193,7 @@ Expected<NavData> read_rinex_nav(const std::vector<std::string>& paths) {
   NavData out;
   for (int i = 0; i < nav->n; ++i) {
     const eph_t& e = nav->eph[i];
+    if (!in_range(e.toe) || !in_range(e.toc) || !in_range(e.ttr)) continue;  // a garbage date: not a usable ephemeris
     int prn = 0;
     System sys{};
     if (!to_system(satsys(e.sat, &prn), sys)) continue;
@@ -219,6 +233,7 @@ Expected<NavData> read_rinex_nav(const std::vector<std::string>& paths) {
   }
   for (int i = 0; i < nav->ng; ++i) {
     const geph_t& g = nav->geph[i];
+    if (!in_range(g.toe) || !in_range(g.tof)) continue;
     int prn = 0;
     satsys(g.sat, &prn);
     GlonassEphemeris ge;
