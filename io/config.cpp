@@ -94,6 +94,7 @@ std::string to_yaml(const RunConfig& c) {
   e << YAML::Key << "doppler_sigma_zenith_mps" << YAML::Value << c.gnss.doppler_sigma_zenith_mps;
   e << YAML::Key << "cn0_ref_dbhz" << YAML::Value << c.gnss.cn0_ref_dbhz;
   e << YAML::Key << "glonass_code_factor" << YAML::Value << c.gnss.glonass_code_factor;
+  e << YAML::Key << "code_smoothing_s" << YAML::Value << c.gnss.code_smoothing_s;
   e << YAML::EndMap;
   if (!c.imu.file.empty()) {
     e << YAML::Key << "imu" << YAML::Value << YAML::BeginMap << YAML::Key << "file" << YAML::Value << c.imu.file;

@@ -36,6 +36,7 @@ struct GnssConfig {
   double doppler_sigma_zenith_mps = 0.05;///< range-rate noise at zenith and C/N0 >= cn0_ref_dbhz [m/s]
   double cn0_ref_dbhz = 45.0;            ///< C/N0 above which the noise no longer decreases [dB-Hz]
   double glonass_code_factor = 3.0;      ///< GLONASS code sigma / GPS code sigma (docs/gnss.md)
+  double code_smoothing_s = 10.0;        ///< pednav gnss: Doppler smoothing window of the code [s], 0 = off (docs/gnss.md "Doppler smoothing of the code")
 };
 
 /// `imu:` section.

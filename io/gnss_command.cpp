@@ -86,6 +86,12 @@ std::string summary_json(const GnssRunSummary& s, const RunConfig& c) {
     j += fmt::format("  \"base_position_source\": \"{}\",\n", s.base_position_from_header ? "rinex_header" : "config");
     j += fmt::format("  \"base_propagation\": \"{}\",\n", c.gnss.base_propagation);
   }
+  auto sm = [](const gnss::CodeSmoothingStats& x) {
+    return fmt::format("{{\"smoothed\": {}, \"restarts_gap\": {}, \"restarts_jump\": {}, \"clock_jumps\": {}}}", x.smoothed,
+                       x.restarts_gap, x.restarts_jump, x.clock_jumps);
+  };
+  j += fmt::format("  \"code_smoothing\": {{\"window_s\": {}, \"rover\": {}, \"base\": {}}},\n",
+                   json_number(c.gnss.code_smoothing_s), sm(s.smoothing_rover), sm(s.smoothing_base));
   j += fmt::format("  \"wall_s\": {}\n}}\n", json_number(s.wall_s));
   return j;
 }
@@ -118,6 +124,12 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
   if (auto ok = check_nav_covers(*nav, *rover, nav_names); !ok) return ok.error();
 
   GnssRunSummary sum;
+  if (g.code_smoothing_s > 0.0) {
+    gnss::CodeSmoothingOptions so;
+    so.window_s = g.code_smoothing_s;
+    sum.smoothing_rover = gnss::smooth_code_with_doppler(rover->epochs, so);
+    if (base) sum.smoothing_base = gnss::smooth_code_with_doppler(base->epochs, so);
+  }
   sum.epochs_read = static_cast<int>(rover->epochs.size());
   sum.rover_event_records = rover->stats.event_records;
   sum.differential = base.has_value();

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/expected.hpp"
+#include "gnss/code_smoothing.hpp"
 #include "gnss/epoch_matching.hpp"
 #include "io/config.hpp"
 
@@ -20,6 +21,7 @@ struct GnssRunSummary {
   bool differential = false;
   bool base_position_from_header = false;
   gnss::AgeStats base_age;
+  gnss::CodeSmoothingStats smoothing_rover, smoothing_base;  ///< Doppler smoothing of the code (docs/gnss.md "Doppler smoothing of the code")
   double wall_s = 0.0;
 };
 

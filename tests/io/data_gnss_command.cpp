@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -27,8 +28,8 @@ constexpr double kGalway2dP95_m = 3.2;
 constexpr double kGalway2dMax_m = 8.0;
 constexpr double kSpirent2dRms_m = 0.05;
 constexpr double kSeptentrioVelRms_mps = 0.05;
-// Issue target 0.36 m (RTKLIB DGPS); pednav measures 0.375 m (docs/results.md) -> asserted at the measured level.
-constexpr double kSeptentrio2dRms_m = 0.38;
+// Issue target 0.36 m (RTKLIB DGPS); measured 0.295 m with the default 10 s Doppler smoothing (0.375 m without).
+constexpr double kSeptentrio2dRms_m = 0.36;
 constexpr double kTimeMatch_s = 0.1;
 
 const std::string kGalway = "gnss_ublox_m8p_walk_galway/";
@@ -135,6 +136,8 @@ TEST(GnssCommandData, GalwayM8pBaseGps) {
   EXPECT_EQ(sum->epochs_read, 1180);
   EXPECT_GE(100.0 * sum->epochs_solved / sum->epochs_read, kGalwayMinSolvedPct);
   const Stats s = galway_errors(out_dir("galway_g") + "/gnss.csv");
+  std::printf("[galway G] solved %d/%d, 2D RMS %.3f p95 %.3f max %.3f m\n", sum->epochs_solved, sum->epochs_read, s.rms,
+              s.p95, s.max);
   EXPECT_EQ(s.compared, 552);
   EXPECT_LE(s.rms, kGalway2dRms_m);
   EXPECT_LE(s.p95, kGalway2dP95_m);
@@ -151,6 +154,8 @@ TEST(GnssCommandData, GalwayGpsGlonassNoWorseThanGps) {
   ASSERT_TRUE(g && gr);
   const Stats sg = galway_errors(out_dir("galway_g2") + "/gnss.csv");
   const Stats sgr = galway_errors(out_dir("galway_gr") + "/gnss.csv");
+  std::printf("[galway G+R] solved %d, 2D RMS %.3f p95 %.3f max %.3f m (G: %.3f %.3f %.3f)\n", gr->epochs_solved, sgr.rms,
+              sgr.p95, sgr.max, sg.rms, sg.p95, sg.max);
   EXPECT_GE(gr->epochs_solved, g->epochs_solved);
   EXPECT_LE(sgr.rms, sg.rms);
   EXPECT_LE(sgr.p95, sg.p95);
@@ -165,6 +170,7 @@ TEST(GnssCommandData, GalwayAgainstCorsGlw1) {
                  "galway_glw1");
   ASSERT_TRUE(sum) << sum.error().message;
   const Stats s = galway_errors(out_dir("galway_glw1") + "/gnss.csv");
+  std::printf("[galway GLW1] solved %d, 2D RMS %.3f p95 %.3f max %.3f m\n", sum->epochs_solved, s.rms, s.p95, s.max);
   EXPECT_EQ(sum->epochs_solved, 1180);
   EXPECT_LE(s.rms, kGalway2dRms_m);  // measured 1.89 m (docs/results.md)
   EXPECT_LE(s.max, kGalway2dMax_m);
@@ -201,6 +207,7 @@ TEST(GnssCommandData, SpirentDynamicNoiseFree) {
     e.push_back(std::hypot(enu.x(), enu.y()));
   }
   const Stats s = stats_of(e);
+  std::printf("[spirent] 2D RMS %.4f max %.4f m over %d epochs\n", s.rms, s.max, s.compared);
   EXPECT_EQ(s.compared, 601);
   EXPECT_LE(s.rms, kSpirent2dRms_m);
 }
@@ -222,6 +229,7 @@ TEST(GnssCommandData, SeptentrioStaticShortBaseline) {
     e.push_back(std::hypot(enu.x(), enu.y()));
     if (!std::isnan(r.v_n.x())) v2 += r.v_n.squaredNorm(), ++nv;
   }
+  std::printf("[septentrio] 2D RMS %.4f m, velocity RMS %.4f m/s\n", stats_of(e).rms, nv ? std::sqrt(v2 / nv) : 0.0);
   EXPECT_EQ(static_cast<int>(e.size()), 301);
   EXPECT_LE(stats_of(e).rms, kSeptentrio2dRms_m);
   ASSERT_GT(nv, 290);
