@@ -164,7 +164,16 @@ Expected<ImuLog> parse_imu_csv(const char* data, size_t size, const std::string&
       p = next;
       continue;
     }
-    const GpsTime t = GpsTime::from_ns(std::llround(t_ns));
+    // Range checked in double; the time itself in integer nanoseconds (a double holds 1.4e18 ns only to 256 ns,
+    // which jitters the sample intervals: test NoiseFreeWalk caught it).
+    GpsTime t;
+    if (fmt.time_base == "gps_sow") {
+      t = GpsTime::from_ns(static_cast<int64_t>(fmt.gps_week) * kNsPerWeek + std::llround(t_s * 1e9));
+    } else if (fmt.time_base == "gpst_unix") {
+      t = GpsTime::from_ns(std::llround((t_s - kGpsMinusUnixEpoch_s) * 1e9));
+    } else {
+      t = GpsTime::from_ns(std::llround(start_ns + t_s * 1e9));
+    }
     const Eigen::Vector3d g_s(vals[1] * gs * fmt.gyro_signs(0), vals[2] * gs * fmt.gyro_signs(1),
                               vals[3] * gs * fmt.gyro_signs(2));
     const Eigen::Vector3d a_s(vals[4] * as * fmt.accel_signs(0), vals[5] * as * fmt.accel_signs(1),

@@ -32,61 +32,14 @@ namespace {
 using SatKeep = std::map<int64_t, std::vector<gnss::SatId>>;  // rover epoch time [ns] -> satellites kept
 
 // The inputs of a tc run, read once and shared by every window's run.
-struct Data {
-  ImuLog imu;
-  gnss::ObsData rover;
-  std::optional<gnss::ObsData> base;
-  gnss::NavData nav;
-  fusion::EngineOptions options;
-};
+using Data = RunInputs;
 
 Expected<Data> load(const RunConfig& c) {
   if (c.mode != "tc") return make_error(c.source_file + ": mode " + c.mode + ": the outage study needs mode tc (set mode: tc or pass --mode tc)");
-  if (!c.imu.has_format || !c.imu.has_spec) {
-    return make_error(c.source_file + ": imu.format and imu.spec are required for the outage study");
-  }
-  Data d;
-  auto imu = read_imu_csv(c.imu.file, c.imu.format);
-  if (!imu) return imu.error();
-  d.imu = std::move(*imu);
-  d.options = engine_options(c);
-  gnss::SystemSelection sel{false, false, false, false, false};
-  for (const auto& s : c.gnss.systems) {
-    sel.gps |= s == "G";
-    sel.glonass |= s == "R";
-    sel.galileo |= s == "E";
-    sel.beidou |= s == "C";
-    sel.qzss |= s == "J";
-  }
-  auto r = gnss::read_rinex_obs(c.gnss.rover_obs, sel);
-  if (!r) return r.error();
-  d.rover = std::move(*r);
-  auto n = gnss::read_rinex_nav(c.gnss.nav);
-  if (!n) return n.error();
-  d.nav = std::move(*n);
-  if (!c.gnss.base_obs.empty()) {
-    auto b = gnss::read_rinex_obs(c.gnss.base_obs, sel);
-    if (!b) return b.error();
-    d.base = std::move(*b);
-    if (c.gnss.base_position_ecef_m) {
-      d.options.base_position_e = c.gnss.base_position_ecef_m;
-    } else if (d.base->has_approx_position) {
-      d.options.base_position_e = d.base->approx_position_e;
-    } else {
-      return make_error(c.gnss.base_obs + ": no base position (set base_position_ecef_m)");
-    }
-  }
-  return d;
+  return load_run_inputs(c);
 }
 
-fusion::EngineInputs inputs(const Data& d) {
-  fusion::EngineInputs in;
-  in.imu = &d.imu.samples;
-  in.nav = &d.nav;
-  in.rover = &d.rover.epochs;
-  if (d.base) in.base = &d.base->epochs;
-  return in;
-}
+fusion::EngineInputs inputs(const Data& d) { return d.engine_inputs(); }
 
 bool system_selected(const std::vector<gnss::System>& systems, gnss::System s) {
   return std::find(systems.begin(), systems.end(), s) != systems.end();
@@ -109,7 +62,7 @@ SatKeep plan_partial(const Data& d, const std::vector<fusion::EpochOutput>& nomi
                      const std::vector<eval::OutageWindow>& windows, int keep, eval::KeepBy by) {
   SatKeep plan;
   const auto& o = d.options;
-  for (const gnss::ObsEpoch& re : d.rover.epochs) {
+  for (const gnss::ObsEpoch& re : d.rover->epochs) {
     if (std::none_of(windows.begin(), windows.end(), [&](const auto& w) { return w.contains(re.time); })) continue;
     const Eigen::Vector3d p_e = position_near(nominal, re.time);
     const gnss::ObsEpoch* be = nullptr;
@@ -135,7 +88,7 @@ SatKeep plan_partial(const Data& d, const std::vector<fusion::EpochOutput>& nomi
         auto bt = std::find_if(be->sats.begin(), be->sats.end(), [&](const gnss::SatObs& b) { return b.sat == so.sat; });
         if (bt == be->sats.end() || std::isnan(bt->pseudorange_m)) continue;
       }
-      auto st = gnss::satellite_state_at_reception(d.nav, so.sat, re.time, so.pseudorange_m);
+      auto st = gnss::satellite_state_at_reception(*d.nav, so.sat, re.time, so.pseudorange_m);
       if (!st) continue;
       const double el = gnss::elevation_azimuth(p_e, st->p_es_e).elevation;
       if (el < o.elevation_mask_rad) continue;
@@ -370,7 +323,7 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
     int mn = 1 << 30, mx = 0;
     double sum = 0.0;
     int n = 0;
-    for (const auto& re : d.rover.epochs) {
+    for (const auto& re : d.rover->epochs) {
       if (!res.windows[k].contains(re.time)) continue;
       int left = 0;
       if (a.keep_sats > 0) {

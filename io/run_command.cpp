@@ -98,54 +98,68 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   return o;
 }
 
-Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::string& out_dir) {
-  const auto wall0 = std::chrono::steady_clock::now();
-  if (c.mode == "gnss") return make_error(c.source_file + ": mode gnss: use `pednav gnss` (run handles tc and ins)");
+fusion::EngineInputs RunInputs::engine_inputs() const {
+  fusion::EngineInputs in;
+  in.imu = &imu.samples;
+  if (rover) in.rover = &rover->epochs;
+  if (nav) in.nav = &*nav;
+  if (base) in.base = &base->epochs;
+  return in;
+}
+
+Expected<RunInputs> load_run_inputs(const RunConfig& c) {
   if (!c.imu.has_format) return make_error(c.source_file + ": imu.format: required for pednav run (a preset name or a column map)");
   if (!c.imu.has_spec) {
     return make_error(c.source_file + ": imu.spec: required for pednav run (a preset name or the noise values)");
   }
+  RunInputs d;
   auto imu = read_imu_csv(c.imu.file, c.imu.format);
   if (!imu) return imu.error();
   for (const auto& w : imu->report.warnings) spdlog::warn("{}: {}", c.imu.file, w);
-  fusion::EngineOptions opt = engine_options(c);
-  fusion::EngineInputs in;
-  in.imu = &imu->samples;
-  std::optional<gnss::ObsData> rover, base;
-  std::optional<gnss::NavData> nav;
-  if (opt.mode == fusion::Mode::kTightlyCoupled) {
-    gnss::SystemSelection sel{false, false, false, false, false};
-    for (const auto& s : c.gnss.systems) {
-      sel.gps |= s == "G";
-      sel.glonass |= s == "R";
-      sel.galileo |= s == "E";
-      sel.beidou |= s == "C";
-      sel.qzss |= s == "J";
-    }
-    auto r = gnss::read_rinex_obs(c.gnss.rover_obs, sel);
-    if (!r) return r.error();
-    rover = std::move(*r);
-    auto n = gnss::read_rinex_nav(c.gnss.nav);
-    if (!n) return n.error();
-    nav = std::move(*n);
-    in.rover = &rover->epochs;
-    in.nav = &*nav;
-    if (!c.gnss.base_obs.empty()) {
-      auto b = gnss::read_rinex_obs(c.gnss.base_obs, sel);
-      if (!b) return b.error();
-      base = std::move(*b);
-      in.base = &base->epochs;
-      if (c.gnss.base_position_ecef_m) {
-        opt.base_position_e = c.gnss.base_position_ecef_m;
-      } else if (base->has_approx_position) {
-        spdlog::warn("{}: base position taken from the RINEX header APPROX POSITION (approximate; set base_position_ecef_m)",
-                     c.gnss.base_obs);
-        opt.base_position_e = base->approx_position_e;
-      } else {
-        return make_error(c.gnss.base_obs + ": no base position (set base_position_ecef_m)");
-      }
+  d.imu = std::move(*imu);
+  d.options = engine_options(c);
+  if (d.options.mode != fusion::Mode::kTightlyCoupled) return d;
+  gnss::SystemSelection sel{false, false, false, false, false};
+  for (const auto& s : c.gnss.systems) {
+    sel.gps |= s == "G";
+    sel.glonass |= s == "R";
+    sel.galileo |= s == "E";
+    sel.beidou |= s == "C";
+    sel.qzss |= s == "J";
+  }
+  auto r = gnss::read_rinex_obs(c.gnss.rover_obs, sel);
+  if (!r) return r.error();
+  d.rover = std::move(*r);
+  auto n = gnss::read_rinex_nav(c.gnss.nav);
+  if (!n) return n.error();
+  d.nav = std::move(*n);
+  if (!c.gnss.base_obs.empty()) {
+    auto b = gnss::read_rinex_obs(c.gnss.base_obs, sel);
+    if (!b) return b.error();
+    d.base = std::move(*b);
+    if (c.gnss.base_position_ecef_m) {
+      d.options.base_position_e = c.gnss.base_position_ecef_m;
+    } else if (d.base->has_approx_position) {
+      spdlog::warn("{}: base position taken from the RINEX header APPROX POSITION (approximate; set base_position_ecef_m)",
+                   c.gnss.base_obs);
+      d.options.base_position_e = d.base->approx_position_e;
+    } else {
+      return make_error(c.gnss.base_obs + ": no base position (set base_position_ecef_m)");
     }
   }
+  return d;
+}
+
+Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::string& out_dir) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  if (c.mode == "gnss") return make_error(c.source_file + ": mode gnss: use `pednav gnss` (run handles tc and ins)");
+  auto loaded = load_run_inputs(c);
+  if (!loaded) return loaded.error();
+  const RunInputs& data = *loaded;
+  const ImuLog* imu = &data.imu;
+  const std::optional<gnss::ObsData>& base = data.base;
+  fusion::EngineOptions opt = data.options;
+  const fusion::EngineInputs in = data.engine_inputs();
   opt.record_gnss_rows = opt.mode == fusion::Mode::kTightlyCoupled;  // residuals.csv
   auto res = fusion::run_forward(in, opt);
   if (!res) return make_error(c.source_file + ": " + res.error().message);

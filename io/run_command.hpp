@@ -3,16 +3,33 @@
 // smoother.enabled also the RTS smoothed smoothed.csv, solution_smoothed.pos and evaluation_smoothed.json.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "core/expected.hpp"
 #include "fusion/engine.hpp"
+#include "gnss/types.hpp"
 #include "io/config.hpp"
+#include "io/imu_csv.hpp"
 
 namespace pednav::io {
 
 /// Map the validated configuration onto the engine options (IMU spec, ZUPT, GNSS weights, antenna, clock).
 fusion::EngineOptions engine_options(const RunConfig& config);
+
+/// The inputs of a run, read once: the IMU log and, in tc mode, rover/base observations and navigation data, with
+/// the engine options (base position from the configuration, else the RINEX header with a warning).
+struct RunInputs {
+  ImuLog imu;
+  std::optional<gnss::ObsData> rover, base;
+  std::optional<gnss::NavData> nav;
+  fusion::EngineOptions options;
+  /// Engine inputs pointing into this object (valid while it lives and is not moved).
+  fusion::EngineInputs engine_inputs() const;
+};
+
+/// Read what a `pednav run` (or an outage study) of this configuration needs; errors name the file and key.
+Expected<RunInputs> load_run_inputs(const RunConfig& config);
 
 /// Run `pednav run` for a loaded configuration and write the outputs into out_dir (created).
 Expected<fusion::EngineSummary> run_run_command(const RunConfig& config, const std::string& out_dir);
