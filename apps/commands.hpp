@@ -18,5 +18,7 @@ void add_run_command(CLI::App& app, Action& action);
 void add_montecarlo_command(CLI::App& app, Action& action);
 void add_outage_command(CLI::App& app, Action& action);
 void add_report_command(CLI::App& app, Action& action);
+void add_zupt_command(CLI::App& app, Action& action);
+void add_hmm_train_command(CLI::App& app, Action& action);
 
 }  // namespace pednav::apps

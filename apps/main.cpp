@@ -27,6 +27,8 @@ int main(int argc, char** argv) {
   pednav::apps::add_montecarlo_command(app, action);
   pednav::apps::add_outage_command(app, action);
   pednav::apps::add_report_command(app, action);
+  pednav::apps::add_zupt_command(app, action);
+  pednav::apps::add_hmm_train_command(app, action);
 
   try {
     app.parse(argc, argv);

@@ -6,6 +6,8 @@
 namespace pednav::ins {
 namespace {
 
+constexpr double kGravityNominal_mps2 = 9.80665;  // g of SHOE (Skog et al. 2010) and MAG
+
 // Half window in samples for a window of `window_s` at the median sample step.
 int half_window(const std::vector<ImuSample>& s, double window_s) {
   if (s.size() < 2) return 0;
@@ -33,7 +35,22 @@ void drop_short_runs(std::vector<ZuptDecision>& d, const std::vector<ImuSample>&
 
 std::vector<std::string> ZuptDetectorOptions::problems() const {
   std::vector<std::string> p;
-  if (detector != "mv" && detector != "shoe") p.push_back("zupt.detector '" + detector + "' is not mv or shoe");
+  if (detector != "mv" && detector != "shoe" && detector != "are" && detector != "mag" && detector != "hmm") {
+    p.push_back("zupt.detector '" + detector + "' is not mv, shoe, are, mag or hmm");
+  }
+  if (are_threshold <= 0) p.push_back("zupt.are_threshold must be > 0");
+  if (mag_threshold <= 0) p.push_back("zupt.mag_threshold must be > 0");
+  if (detector == "hmm") {
+    for (const auto& q : hmm_observations.problems()) p.push_back("zupt." + q);
+    if (hmm_model) {
+      for (const auto& q : hmm_model->problems()) p.push_back("zupt.hmm_model: " + q);
+    }
+    if (hmm_decoder != "viterbi" && hmm_decoder != "forward") {
+      p.push_back("zupt.hmm_decoder '" + hmm_decoder + "' is not viterbi or forward");
+    }
+    if (hmm_max_iterations < 0) p.push_back("zupt.hmm_max_iterations must be >= 0");
+    if (!(hmm_decode_floor >= 0 && hmm_decode_floor < 0.01)) p.push_back("zupt.hmm_decode_floor must be in [0, 0.01)");
+  }
   if (mv_window_s <= 0) p.push_back("zupt.mv_window_s must be > 0");
   if (mv_threshold_mps2 <= 0) p.push_back("zupt.mv_threshold_mps2 must be > 0");
   if (shoe_window_s <= 0) p.push_back("zupt.shoe_window_s must be > 0");
@@ -43,11 +60,91 @@ std::vector<std::string> ZuptDetectorOptions::problems() const {
   return p;
 }
 
+HmmDetection detect_gait_hmm(const std::vector<ImuSample>& s, const ZuptDetectorOptions& o) {
+  HmmDetection h;
+  h.decisions.resize(s.size());
+  const HmmModel initial = o.hmm_model ? *o.hmm_model : seed002_initial_model();
+  auto extract = [&](double sign) {
+    HmmObservationOptions x = o.hmm_observations;
+    x.sign = sign;
+    return extract_gait_observations(s, x);
+  };
+  // Axis sign: the configured one, or (hmm_auto_sign) the one that makes push-off negative as in seed 002
+  // (Fig. 2e, Table 1: push-off emits the lowest grades). Push-off is the first large excursion after a rest:
+  // after every run of >= kRestForSign_s in the zero grade, the first sample at >= kExcursionGrades grades from
+  // it votes with its sign; a majority of positive votes flips the sign, a tie keeps the configured one.
+  h.sign = o.hmm_observations.sign;
+  h.observations = extract(h.sign);
+  if (o.hmm_auto_sign) {
+    constexpr double kRestForSign_s = 0.1;
+    constexpr int kExcursionGrades = 3, kZeroGrade = 7;
+    const auto& g = h.observations.grade;
+    int votes = 0;  // positive first excursions minus negative ones
+    for (std::size_t k = 0; k < g.size();) {
+      if (g[k] != kZeroGrade) {
+        ++k;
+        continue;
+      }
+      std::size_t j = k;
+      while (j + 1 < g.size() && g[j + 1] == kZeroGrade) ++j;
+      if (s[j].t - s[k].t >= kRestForSign_s) {
+        std::size_t m = j + 1;
+        while (m < g.size() && std::abs(g[m] - kZeroGrade) < kExcursionGrades) ++m;
+        if (m < g.size()) votes += g[m] > kZeroGrade ? 1 : -1;
+      }
+      k = j + 1;
+    }
+    if (votes > 0) {
+      h.sign = -h.sign;
+      h.observations = extract(h.sign);
+    }
+  }
+  h.model = initial;
+  const std::vector<int> symbols = h.observations.symbols();
+  if (o.hmm_train_on_log && symbols.size() >= 2) {
+    BaumWelchOptions bw;
+    bw.max_iterations = o.hmm_max_iterations;
+    h.training = baum_welch(initial, {symbols}, bw);
+    h.model = h.training.model;
+  }
+  const HmmModel decode_model = floored(h.model, o.hmm_decode_floor);
+  h.obs_states = o.hmm_decoder == "forward" ? forward_decode(decode_model, symbols) : viterbi(decode_model, symbols);
+  const std::vector<int> per_sample = states_per_sample(h.observations, h.obs_states);
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    h.decisions[k].statistic = h.observations.rate_radps[k];
+    h.decisions[k].gait_state = per_sample[k];
+    h.decisions[k].stance = per_sample[k] == kStance;
+  }
+  drop_short_runs(h.decisions, s, o.min_stance_s);
+  return h;
+}
+
 std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& s, const ZuptDetectorOptions& o) {
   const int n = static_cast<int>(s.size());
   std::vector<ZuptDecision> d(n);
   if (n == 0) return d;
-  if (o.detector == "shoe") {
+  if (o.detector == "hmm") return detect_gait_hmm(s, o).decisions;
+  if (o.detector == "are" || o.detector == "mag") {
+    // Skog et al. 2010 eq. 8 (ARE) and 9 (MAG), window W centred on the sample.
+    const int h = half_window(s, o.shoe_window_s);
+    const double ia = 1.0 / (o.shoe_sigma_accel_mps2 * o.shoe_sigma_accel_mps2);
+    const double ig = 1.0 / (o.shoe_sigma_gyro_radps * o.shoe_sigma_gyro_radps);
+    const bool are = o.detector == "are";
+    for (int k = 0; k < n; ++k) {
+      const int a = std::max(0, k - h), b = std::min(n - 1, k + h);
+      double t = 0.0;
+      for (int j = a; j <= b; ++j) {
+        if (are) {
+          t += ig * s[j].omega_ib_b.squaredNorm();
+        } else {
+          const double e = s[j].f_ib_b.norm() - kGravityNominal_mps2;
+          t += ia * e * e;
+        }
+      }
+      d[k].statistic = t / static_cast<double>(b - a + 1);
+      d[k].stance = d[k].statistic < (are ? o.are_threshold : o.mag_threshold);
+    }
+  } else if (o.detector == "shoe") {
     const int h = half_window(s, o.shoe_window_s);
     const double ia = 1.0 / (o.shoe_sigma_accel_mps2 * o.shoe_sigma_accel_mps2);
     const double ig = 1.0 / (o.shoe_sigma_gyro_radps * o.shoe_sigma_gyro_radps);
@@ -56,7 +153,7 @@ std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& s, const Z
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
       for (int j = a; j <= b; ++j) mean += s[j].f_ib_b;
       mean /= static_cast<double>(b - a + 1);
-      const Eigen::Vector3d g_dir = mean.norm() > 0 ? Eigen::Vector3d(mean.normalized() * 9.80665) : Eigen::Vector3d::Zero();
+      const Eigen::Vector3d g_dir = mean.norm() > 0 ? Eigen::Vector3d(mean.normalized() * kGravityNominal_mps2) : Eigen::Vector3d::Zero();
       double t = 0.0;
       for (int j = a; j <= b; ++j) t += ia * (s[j].f_ib_b - g_dir).squaredNorm() + ig * s[j].omega_ib_b.squaredNorm();
       d[k].statistic = t / static_cast<double>(b - a + 1);

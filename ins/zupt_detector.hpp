@@ -1,17 +1,19 @@
-// Zero-velocity (stance) detectors for a foot-mounted IMU, run offline over a whole log (post-processing:
-// windows are centred on the sample they decide). docs/zupt.md.
+// Zero-velocity (stance) detectors for a foot-mounted IMU (SHOE, ARE, MAG, moving variance, HMM), run offline over
+// a whole log (post-processing: windows are centred on the sample they decide). docs/zupt.md.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/expected.hpp"
+#include "ins/hmm.hpp"
 #include "ins/imu.hpp"
 
 namespace pednav::ins {
 
 struct ZuptDetectorOptions {
-  std::string detector = "shoe";    ///< shoe (Skog et al. 2010 GLRT) | mv (seed 004 eq. 1)
+  std::string detector = "shoe";    ///< shoe (Skog et al. 2010 GLRT) | mv (seed 004 eq. 1) | are | mag | hmm (seed 002)
   // Moving variance (seed 004 eq. 1): stance when std(|f|) over the window < threshold AND the time since
   // the current step started exceeds min_time_since_step_s.
   double mv_window_s = 0.05;        ///< variance window [s] (seed 004: 3 samples at 100 Hz ~ 0.03 s)
@@ -23,6 +25,20 @@ struct ZuptDetectorOptions {
   double shoe_sigma_accel_mps2 = 0.5;
   double shoe_sigma_gyro_radps = 0.1;
   double shoe_threshold = 10.0;     ///< γ
+  // ARE and MAG (Skog et al. 2010 eq. 8, 9), same window W and sigmas as SHOE:
+  // ARE T = 1/(σω² W) Σ|ω|² < γ_are; MAG T = 1/(σa² W) Σ(|f| - g)² < γ_mag.
+  double are_threshold = 10.0;      ///< γ_are (10 with σω 0.1 rad/s: RMS rate below 0.32 rad/s)
+  double mag_threshold = 2.0;       ///< γ_mag (2 with σa 0.5 m/s^2: RMS of |f| - g below 0.71 m/s^2)
+  // HMM (seed 002 §3; docs/zupt.md): observations from the gyro axis across the foot, decoded gait states.
+  HmmObservationOptions hmm_observations;  ///< axis/sign, smoothing window, grade width
+  std::optional<HmmModel> hmm_model;       ///< trained model (hmm.yaml); absent: seed 002 A1 + Table 1
+  bool hmm_train_on_log = true;            ///< Baum-Welch on this log's own observations before decoding
+  /// Flip the configured axis sign when most first excursions after a rest (push-off) are positive (docs/zupt.md):
+  /// a sensor mounted turned by 180° about its vertical axis flips the sign of the across-the-foot rate.
+  bool hmm_auto_sign = true;
+  int hmm_max_iterations = 200;            ///< Baum-Welch iterations at most
+  std::string hmm_decoder = "viterbi";     ///< viterbi (whole log) | forward (online filtering)
+  double hmm_decode_floor = 1e-6;          ///< A, B entries raised to this for decoding (unseen symbols)
   double min_stance_s = 0.04;       ///< shorter stance runs are discarded [s]
   /// Every problem at once, empty when valid ("zupt.mv_threshold_mps2 must be > 0").
   std::vector<std::string> problems() const;
@@ -31,8 +47,23 @@ struct ZuptDetectorOptions {
 /// Per-sample decision.
 struct ZuptDecision {
   bool stance = false;
-  double statistic = 0.0;  ///< mv: std(|f|) [m/s^2]; shoe: T
+  double statistic = 0.0;  ///< mv: std(|f|) [m/s^2]; shoe, are, mag: T; hmm: smoothed signed axis rate [rad/s]
+  int gait_state = -1;     ///< hmm: decoded state per sample (GaitState 0..3), else -1
 };
+
+/// The HMM detector's by-products (for `pednav zupt` and the documentation).
+struct HmmDetection {
+  std::vector<ZuptDecision> decisions;  ///< one per sample
+  GaitObservations observations;        ///< extracted observation sequence
+  double sign = 1.0;                    ///< axis sign used (hmm_auto_sign may flip the configured one)
+  std::vector<int> obs_states;          ///< decoded state per observation
+  HmmModel model;                       ///< model used for decoding (trained on the log if configured)
+  BaumWelchResult training;             ///< empty log_likelihood when not trained on the log
+};
+
+/// HMM detector of seed 002 over time-ordered samples (GPST): extraction, optional Baum-Welch on the log,
+/// decoding, mapping to samples (states_per_sample), stance = state D, short runs dropped.
+HmmDetection detect_gait_hmm(const std::vector<ImuSample>& samples, const ZuptDetectorOptions& options);
 
 /// Run the configured detector over time-ordered samples (GPST). Returns one decision per sample.
 std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& samples, const ZuptDetectorOptions& options);

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/expected.hpp"
+#include "ins/hmm.hpp"
 #include "ins/imu_spec.hpp"
 #include "io/imu_csv.hpp"
 
@@ -59,7 +60,7 @@ struct ReferenceConfig {
 
 /// `zupt:` section.
 struct ZuptConfig {
-  std::string detector = "shoe";  ///< shoe (Skog et al. 2010) | mv (seed 004 eq. 1) | hmm
+  std::string detector = "shoe";  ///< shoe (Skog et al. 2010) | mv (seed 004 eq. 1) | are | mag | hmm (seed 002)
   std::string form = "D";       ///< D (seed 001 eq. 8) | F (seed 001 eq. 9)
   double mv_window_s = 0.05;              ///< key mv_window_s
   double mv_threshold_mps2 = 0.6;         ///< key mv_threshold_mps2
@@ -70,6 +71,17 @@ struct ZuptConfig {
   double shoe_sigma_gyro_radps = 0.1;     ///< key shoe_sigma_gyro_deg_per_s
   double shoe_threshold = 10.0;
   double min_stance_s = 0.04;
+  double are_threshold = 10.0;            ///< ARE γ (Skog et al. 2010 eq. 8)
+  double mag_threshold = 2.0;             ///< MAG γ (Skog et al. 2010 eq. 9)
+  std::string hmm_gyro_axis = "y";        ///< x | y | z | -x | -y | -z: the axis across the foot, signed (docs/zupt.md)
+  double hmm_smooth_window_s = 0.05;      ///< moving-average window of the HMM observations
+  double hmm_grade_width_radps = 60.0 * 3.14159265358979323846 / 180.0;  ///< key hmm_grade_width_deg_per_s
+  std::string hmm_model_file;             ///< key hmm_model (pednav hmm-train output); empty: seed 002 Table 1
+  std::optional<ins::HmmModel> hmm_model; ///< loaded from hmm_model_file
+  bool hmm_train_on_log = true;           ///< Baum-Welch on the processed log before decoding
+  bool hmm_auto_sign = true;              ///< try both signs of hmm_gyro_axis, keep the likelier (docs/zupt.md)
+  int hmm_max_iterations = 200;
+  std::string hmm_decoder = "viterbi";    ///< viterbi | forward
   double sigma_mps = 0.02;                ///< ZUPT measurement noise per axis
   bool zaru = true;
   double zaru_sigma_radps = 0.01;         ///< key zaru_sigma_deg_per_s
@@ -137,6 +149,8 @@ std::string to_yaml(const RunConfig& config);
 void read_gnss_section(YamlMap& top, GnssConfig& out);
 void read_imu_section(YamlMap& top, ImuConfig& out);
 void read_filter_section(YamlMap& top, RunConfig& out);
+/// Read the ARE/MAG/HMM keys of the zupt section (io/hmm_model_io.cpp; loads zupt.hmm_model).
+void read_zupt_hmm_keys(YamlMap& zupt, ZuptConfig& out);
 /// Read an IMU column map (keys of README "IMU log format") from `m` into `out`.
 void read_imu_format(YamlMap& m, ImuFormat& out);
 /// Read inline IMU spec keys (unit-suffixed, README "IMU spec") from `m` into `out` (SI).

@@ -9,7 +9,7 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
   top.number("mechanization_rate_hz", out.mechanization_rate_hz, false, 1e-3, 2000.0);
   {
     YamlMap z = top.map("zupt");
-    z.choice("detector", out.zupt.detector, {"mv", "shoe", "hmm"});
+    z.choice("detector", out.zupt.detector, {"mv", "shoe", "are", "mag", "hmm"});
     z.choice("form", out.zupt.form, {"D", "F"});
     ZuptConfig& c = out.zupt;
     z.number("mv_window_s", c.mv_window_s, false, 1e-3, 5.0);
@@ -25,6 +25,7 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
     c.shoe_sigma_gyro_radps = sg * kDegToRad;
     z.number("shoe_threshold", c.shoe_threshold, false, 1e-9, 1e12);
     z.number("min_stance_s", c.min_stance_s, false, 0.0, 5.0);
+    read_zupt_hmm_keys(z, c);
     z.number("sigma_mps", c.sigma_mps, false, 1e-6, 10.0);
     z.boolean("zaru", c.zaru);
     double zs = c.zaru_sigma_radps * kRadToDeg;

@@ -14,6 +14,7 @@
 #include "io/atomic_file.hpp"
 #include "io/residuals_writer.hpp"
 #include "io/compare_command.hpp"
+#include "io/hmm_model_io.hpp"
 #include "io/imu_csv.hpp"
 #include "io/solution_writer.hpp"
 #include "io/trajectory_io.hpp"
@@ -63,6 +64,7 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.zupt.shoe_sigma_gyro_radps = c.zupt.shoe_sigma_gyro_radps;
   o.zupt.shoe_threshold = c.zupt.shoe_threshold;
   o.zupt.min_stance_s = c.zupt.min_stance_s;
+  o.zupt = zupt_detector_options(c.zupt);  // all detector keys incl. ARE/MAG/HMM (io/hmm_model_io.cpp)
   o.zupt_form = c.zupt.form == "F" ? fusion::ZuptForm::kFull : fusion::ZuptForm::kDynamic;
   o.zupt_sigma_mps = c.zupt.sigma_mps;
   o.zaru = c.zupt.zaru;

@@ -1,0 +1,35 @@
+// `pednav zupt CONFIG.yaml -o OUT` (run the configured zero-velocity detector over the IMU log: zupt.csv,
+// summary.json) and `pednav hmm-train CONFIG.yaml... -o hmm.yaml` (Baum-Welch over one or more logs).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/expected.hpp"
+#include "io/config.hpp"
+#include "io/hmm_model_io.hpp"
+
+namespace pednav::io {
+
+/// What `pednav zupt` found.
+struct ZuptCommandSummary {
+  std::string detector;
+  long samples = 0;
+  long stance_samples = 0;
+  long stance_intervals = 0;        ///< runs of stance samples ("steps" incl. the initial and final rest)
+  long hmm_observations = 0;        ///< hmm only: length of the observation sequence
+  int hmm_iterations = 0;           ///< hmm only: Baum-Welch iterations on the log
+  ins::HmmModel hmm_model;          ///< hmm only: the model used for decoding
+  double wall_s = 0.0;
+};
+
+/// Run the configured detector (config.zupt) over config.imu.file; writes out_dir/zupt.csv (gps_week, gps_tow_s,
+/// stance, statistic, hmm_state, hmm_grade) and out_dir/summary.json.
+Expected<ZuptCommandSummary> run_zupt_command(const RunConfig& config, const std::string& out_dir);
+
+/// Train the HMM on the IMU logs of `configs` (all with the same hmm extraction keys), starting from the first
+/// config's zupt.hmm_model or seed 002's initial model; writes hmm.yaml to out_path.
+Expected<HmmModelFile> run_hmm_train_command(const std::vector<RunConfig>& configs, const std::string& out_path,
+                                             int max_iterations);
+
+}  // namespace pednav::io
