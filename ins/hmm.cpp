@@ -75,6 +75,7 @@ std::vector<std::string> HmmObservationOptions::problems() const {
   if (sign != 1.0 && sign != -1.0) p.push_back("hmm gyro axis sign must be +1 or -1");
   if (!(smooth_window_s >= 0)) p.push_back("hmm smoothing window must be >= 0 s");
   if (!(grade_width_radps > 0)) p.push_back("hmm grade width must be > 0");
+  if (!(min_prominence_grades >= 0)) p.push_back("hmm extreme prominence must be >= 0 grades");
   return p;
 }
 
@@ -85,8 +86,8 @@ std::vector<int> GaitObservations::symbols() const {
 }
 
 int quantize_rate(double rate_radps, double grade_width_radps) {
-  const double g = std::round(rate_radps / grade_width_radps);
-  return static_cast<int>(std::clamp(7.0 + g, 0.0, static_cast<double>(kHmmSymbols - 1)));
+  const double g = std::floor(rate_radps / grade_width_radps);
+  return static_cast<int>(std::clamp(8.0 + g, 0.0, static_cast<double>(kHmmSymbols - 1)));
 }
 
 GaitObservations extract_gait_observations(const std::vector<ImuSample>& s, const HmmObservationOptions& o) {
@@ -109,7 +110,8 @@ GaitObservations extract_gait_observations(const std::vector<ImuSample>& s, cons
     out.rate_radps[k] = (prefix[b + 1] - prefix[a]) / static_cast<double>(b - a + 1);
     out.grade[k] = quantize_rate(out.rate_radps[k], o.grade_width_radps);
   }
-  // c) extremes: strict on the left, non-strict on the right (one index per plateau); both ends count.
+  // c) extremes with hysteresis: a maximum (minimum) counts once the rate has fallen (risen) by more than
+  //    `prominence` from it, so wiggles smaller than that, e.g. noise across a grade boundary, make no extremes.
   // d)+e) quantize each extreme; a run of consecutive extremes in the same grade is one observation.
   const auto& r = out.rate_radps;
   auto add = [&](std::size_t k) {
@@ -120,10 +122,21 @@ GaitObservations extract_gait_observations(const std::vector<ImuSample>& s, cons
     out.obs.push_back({out.grade[k], k, k, r[k]});
   };
   add(0);
-  for (std::size_t k = 1; k + 1 < n; ++k) {
-    const bool is_max = r[k] > r[k - 1] && r[k] >= r[k + 1];
-    const bool is_min = r[k] < r[k - 1] && r[k] <= r[k + 1];
-    if (is_max || is_min) add(k);
+  const double prominence = o.min_prominence_grades * o.grade_width_radps;
+  std::size_t imax = 0, imin = 0;
+  int looking = 0;  // +1: for a maximum, -1: for a minimum, 0: either (start)
+  for (std::size_t k = 1; k < n; ++k) {
+    if (r[k] > r[imax]) imax = k;
+    if (r[k] < r[imin]) imin = k;
+    if (looking >= 0 && r[k] < r[imax] - prominence && imax > 0) {
+      add(imax);
+      looking = -1;
+      imin = k;
+    } else if (looking <= 0 && r[k] > r[imin] + prominence && imin > 0) {
+      add(imin);
+      looking = 1;
+      imax = k;
+    }
   }
   if (n > 1) add(n - 1);
   return out;
@@ -300,31 +313,49 @@ HmmDraw draw_hmm_sequence(const HmmModel& m, int length, std::uint64_t seed) {
   return d;
 }
 
-std::vector<int> states_per_sample(const GaitObservations& g, const std::vector<int>& q) {
+std::vector<int> states_per_sample(const GaitObservations& g, const std::vector<int>& q,
+                                   const std::array<bool, kHmmSymbols>& stance_grades) {
   const std::size_t n = g.rate_radps.size(), N = g.obs.size();
   std::vector<int> out(n, -1);
   if (n == 0 || N == 0 || q.size() != N) return out;
-  // Dwell [lo_k, hi_k] of observation k: its extremes, widened while the grade stays its symbol.
+  // Dwell [lo_k, hi_k] of observation k: its extremes, widened while the grade stays its symbol (stance: while
+  // the grade is its symbol or one of stance_grades), never beyond the neighbouring observations' extremes.
   std::vector<std::size_t> lo(N), hi(N);
   for (std::size_t k = 0; k < N; ++k) {
     const auto& ob = g.obs[k];
     const std::size_t left_bound = k > 0 ? g.obs[k - 1].last + 1 : 0;
     const std::size_t right_bound = k + 1 < N ? g.obs[k + 1].first - 1 : n - 1;
+    auto in_dwell = [&](std::size_t i) {
+      return g.grade[i] == ob.symbol || (q[k] == kStance && stance_grades[static_cast<std::size_t>(g.grade[i])]);
+    };
     lo[k] = ob.first;
     hi[k] = ob.last;
-    while (lo[k] > left_bound && g.grade[lo[k] - 1] == ob.symbol) --lo[k];
-    while (hi[k] < right_bound && g.grade[hi[k] + 1] == ob.symbol) ++hi[k];
+    while (lo[k] > left_bound && in_dwell(lo[k] - 1)) --lo[k];
+    while (hi[k] < right_bound && in_dwell(hi[k] + 1)) ++hi[k];
   }
   for (std::size_t k = 0; k < N; ++k) {
-    for (std::size_t i = lo[k]; i <= hi[k]; ++i) out[i] = q[k];
     // Transit to the next observation's dwell: the next state, except into stance (keep this state).
     if (k + 1 < N) {
       const int transit = q[k + 1] == kStance ? q[k] : q[k + 1];
-      for (std::size_t i = hi[k] + 1; i < lo[k + 1]; ++i) out[i] = transit;
+      for (std::size_t i = hi[k] + 1; i < std::max(lo[k + 1], hi[k] + 1); ++i) out[i] = transit;
     }
   }
   for (std::size_t i = 0; i < lo[0]; ++i) out[i] = q[0];
+  // Dwells last, stance dwells after the others: a widened stance dwell wins where it overlaps a neighbour's.
+  for (int pass = 0; pass < 2; ++pass) {
+    for (std::size_t k = 0; k < N; ++k) {
+      if ((q[k] == kStance) != (pass == 1)) continue;
+      for (std::size_t i = lo[k]; i <= hi[k]; ++i) out[i] = q[k];
+    }
+  }
   return out;
+}
+
+std::array<bool, kHmmSymbols> stance_grades(const HmmModel& model, double min_probability) {
+  std::array<bool, kHmmSymbols> g{};
+  for (int k = 0; k < kHmmSymbols; ++k) g[static_cast<std::size_t>(k)] = model.B(kStance, k) >= min_probability;
+  g[7] = g[8] = true;  // grades 8 and 9 meet at zero rate: noise at rest alternates between them
+  return g;
 }
 
 }  // namespace pednav::ins

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -52,7 +53,8 @@ struct HmmObservationOptions {
   int axis = 1;                 ///< gyro axis across the foot: 0 x, 1 y, 2 z of the IMU body frame
   double sign = 1.0;            ///< +1 or -1 so that push-off is negative and swing positive (as in seed 002 Fig. 2e)
   double smooth_window_s = 0.05;    ///< moving-average window (centred) [s]
-  double grade_width_radps = 1.05;  ///< width of one grade [rad/s]; grade 8 = [-w/2, w/2), grades 1 and 15 open
+  double grade_width_radps = 1.05;  ///< width of one grade [rad/s]; grade 8 = [-w, 0), 9 = [0, w), 1 and 15 open
+  double min_prominence_grades = 0.5;  ///< an extreme counts once the rate moved this many grades away from it
   /// Every problem at once, empty when valid.
   std::vector<std::string> problems() const;
 };
@@ -65,12 +67,14 @@ struct GaitObservations {
   std::vector<int> symbols() const; ///< obs[k].symbol
 };
 
-/// Grade (0-based symbol) of a rate [rad/s]: 7 + round(rate / width), clamped to 0..14.
+/// Grade (0-based symbol) of a rate [rad/s]: 8 + floor(rate / width), clamped to 0..14, so zero rate is the
+/// boundary of grades 8 and 9, the two grades seed 002's stance state emits (Table 1: 85 %; docs/zupt.md §2).
 int quantize_rate(double rate_radps, double grade_width_radps);
 
 /// Observation extraction of seed 002 §3.3 over time-ordered samples (any rate): signed rate of the chosen
-/// axis -> centred moving average -> local extremes (both log ends count as extremes) -> quantization into 15
-/// grades -> runs of consecutive extremes in the same grade merged into one observation.
+/// axis -> centred moving average -> local extremes with a minimum prominence (the first sample counts as an
+/// extreme) -> quantization into 15 grades -> runs of consecutive extremes in the same grade merged into one
+/// observation.
 GaitObservations extract_gait_observations(const std::vector<ImuSample>& samples, const HmmObservationOptions& options);
 
 /// Scaled forward-backward (Rabiner 1989 eq. 91-93) of one sequence.
@@ -124,9 +128,14 @@ HmmDraw draw_hmm_sequence(const HmmModel& model, int length, std::uint64_t seed)
 
 /// Map states decoded on the observations back to samples (docs/zupt.md §3): the state of observation n holds
 /// on its dwell (the run of samples around its extremes whose grade equals its symbol, bounded by the
-/// neighbouring observations); samples between two dwells take the state of the next observation, except
-/// before a stance (D) observation, where they keep the previous state (stance only while the signal stays in
-/// the stance observation's grade). Returns one state index per sample.
-std::vector<int> states_per_sample(const GaitObservations& observations, const std::vector<int>& obs_states);
+/// neighbouring observations' extremes; for a stance (D) observation also grades flagged in `stance_grades`);
+/// samples between two dwells take the state of the next observation, except before a stance observation, where
+/// they keep the previous state (stance only while the signal stays in a stance grade). One state per sample.
+std::vector<int> states_per_sample(const GaitObservations& observations, const std::vector<int>& obs_states,
+                                   const std::array<bool, kHmmSymbols>& stance_grades = {});
+
+/// Grades the stance state D of `model` emits with probability >= min_probability (b_D(k) >= p), and always
+/// grades 8 and 9 (zero rate is their boundary, so the rate at rest alternates between them).
+std::array<bool, kHmmSymbols> stance_grades(const HmmModel& model, double min_probability);
 
 }  // namespace pednav::ins

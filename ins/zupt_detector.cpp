@@ -71,26 +71,29 @@ HmmDetection detect_gait_hmm(const std::vector<ImuSample>& s, const ZuptDetector
   };
   // Axis sign: the configured one, or (hmm_auto_sign) the one that makes push-off negative as in seed 002
   // (Fig. 2e, Table 1: push-off emits the lowest grades). Push-off is the first large excursion after a rest:
-  // after every run of >= kRestForSign_s in the zero grade, the first sample at >= kExcursionGrades grades from
-  // it votes with its sign; a majority of positive votes flips the sign, a tie keeps the configured one.
+  // after every run of >= kRestForSign_s in the two grades at zero rate, the first sample at >= kExcursionGrades
+  // grades beyond them votes with its sign; a majority of positive votes flips the sign, a tie keeps the
+  // configured one.
   h.sign = o.hmm_observations.sign;
   h.observations = extract(h.sign);
   if (o.hmm_auto_sign) {
     constexpr double kRestForSign_s = 0.1;
-    constexpr int kExcursionGrades = 3, kZeroGrade = 7;
+    constexpr int kExcursionGrades = 3;
+    // Rest: the two grades that meet at zero rate (8 = [-w, 0), 9 = [0, w); 0-based 7 and 8).
+    auto rest = [](int grade) { return grade == 7 || grade == 8; };
     const auto& g = h.observations.grade;
     int votes = 0;  // positive first excursions minus negative ones
     for (std::size_t k = 0; k < g.size();) {
-      if (g[k] != kZeroGrade) {
+      if (!rest(g[k])) {
         ++k;
         continue;
       }
       std::size_t j = k;
-      while (j + 1 < g.size() && g[j + 1] == kZeroGrade) ++j;
+      while (j + 1 < g.size() && rest(g[j + 1])) ++j;
       if (s[j].t - s[k].t >= kRestForSign_s) {
         std::size_t m = j + 1;
-        while (m < g.size() && std::abs(g[m] - kZeroGrade) < kExcursionGrades) ++m;
-        if (m < g.size()) votes += g[m] > kZeroGrade ? 1 : -1;
+        while (m < g.size() && g[m] > 7 - kExcursionGrades && g[m] < 8 + kExcursionGrades) ++m;
+        if (m < g.size()) votes += g[m] > 8 ? 1 : -1;
       }
       k = j + 1;
     }
@@ -109,7 +112,8 @@ HmmDetection detect_gait_hmm(const std::vector<ImuSample>& s, const ZuptDetector
   }
   const HmmModel decode_model = floored(h.model, o.hmm_decode_floor);
   h.obs_states = o.hmm_decoder == "forward" ? forward_decode(decode_model, symbols) : viterbi(decode_model, symbols);
-  const std::vector<int> per_sample = states_per_sample(h.observations, h.obs_states);
+  const std::vector<int> per_sample =
+      states_per_sample(h.observations, h.obs_states, stance_grades(h.model, o.hmm_stance_grade_probability));
   for (std::size_t k = 0; k < s.size(); ++k) {
     h.decisions[k].statistic = h.observations.rate_radps[k];
     h.decisions[k].gait_state = per_sample[k];

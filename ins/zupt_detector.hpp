@@ -39,6 +39,9 @@ struct ZuptDetectorOptions {
   int hmm_max_iterations = 200;            ///< Baum-Welch iterations at most
   std::string hmm_decoder = "viterbi";     ///< viterbi (whole log) | forward (online filtering)
   double hmm_decode_floor = 1e-6;          ///< A, B entries raised to this for decoding (unseen symbols)
+  /// A stance dwell extends over samples in any grade the (trained) stance state emits with at least this
+  /// probability (docs/zupt.md §3); > 1 keeps stance to its observation's own grade.
+  double hmm_stance_grade_probability = 0.05;
   double min_stance_s = 0.04;       ///< shorter stance runs are discarded [s]
   /// Every problem at once, empty when valid ("zupt.mv_threshold_mps2 must be > 0").
   std::vector<std::string> problems() const;

@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <numeric>
 
@@ -167,10 +168,11 @@ TEST(Hmm, DecodersFollowTheCycle) {
 
 TEST(Hmm, QuantizationGrades) {
   constexpr double w = 1.0;
-  EXPECT_EQ(quantize_rate(0.0, w), 7);   // grade 8 is centred on zero
-  EXPECT_EQ(quantize_rate(0.49, w), 7);
-  EXPECT_EQ(quantize_rate(0.51, w), 8);
-  EXPECT_EQ(quantize_rate(-0.51, w), 6);
+  EXPECT_EQ(quantize_rate(0.0, w), 8);   // grade 9 = [0, w)
+  EXPECT_EQ(quantize_rate(0.99, w), 8);
+  EXPECT_EQ(quantize_rate(1.01, w), 9);
+  EXPECT_EQ(quantize_rate(-0.01, w), 7);  // grade 8 = [-w, 0)
+  EXPECT_EQ(quantize_rate(-1.01, w), 6);
   EXPECT_EQ(quantize_rate(-100.0, w), 0);
   EXPECT_EQ(quantize_rate(100.0, w), 14);
 }
@@ -212,7 +214,7 @@ TEST(Hmm, ExtractionMergesRedundantExtremes) {
   o.grade_width_radps = 1.0;
   const GaitObservations g = extract_gait_observations(s, o);
   // Per cycle: stance (ripple merged into one grade-8 observation), push-off min, swing max, heel-strike min.
-  const std::vector<int> expected = {7, 1, 13, 4, 7, 1, 13, 4, 7, 1, 13, 4, 7};
+  const std::vector<int> expected = {8, 1, 13, 4, 8, 1, 13, 4, 8, 1, 13, 4, 8};
   std::vector<int> got = g.symbols();
   // Smoothing lowers the peaks by < 1 grade; accept +-1 grade on the extremes, exact order and count.
   ASSERT_EQ(got.size(), expected.size());
@@ -228,7 +230,9 @@ TEST(Hmm, StatesPerSampleMapsStanceToTheDwell) {
   // The true state of each observation: the cycle D A B C ...
   std::vector<int> q;
   for (std::size_t k = 0; k < g.obs.size(); ++k) q.push_back(k % 4 == 0 ? kStance : static_cast<int>(k % 4) - 1);
-  const std::vector<int> per = states_per_sample(g, q);
+  std::array<bool, kHmmSymbols> zero_grades{};
+  zero_grades[7] = zero_grades[8] = true;
+  const std::vector<int> per = states_per_sample(g, q, zero_grades);
   ASSERT_EQ(per.size(), s.size());
   // Stance samples: exactly the samples whose smoothed rate is within half a grade of zero around each true
   // stance; each true stance interval is covered to within the smoothing and the half-grade band (0.04 s).
