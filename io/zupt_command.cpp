@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -10,6 +11,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/imu_csv.hpp"
+#include "io/plot.hpp"
 
 namespace pednav::io {
 namespace {
@@ -95,6 +97,37 @@ Expected<ZuptCommandSummary> run_zupt_command(const RunConfig& c, const std::str
   j["stance_samples"] = sum.stance_samples;
   j["stance_intervals"] = sum.stance_intervals;
   j["wall_s"] = sum.wall_s;
+  // Detections plot (io/plot, gnuplot): stance flag and the statistic scaled to its largest magnitude (HMM: the
+  // smoothed signed axis rate; also the decoded state / 3), at most ~20000 points. A missing gnuplot is a warning.
+  {
+    PlotSpec ps;
+    ps.title = "zero-velocity detector " + sum.detector + ": " + std::to_string(sum.stance_intervals) + " stance intervals";
+    ps.x_label = "GPS time of week [s]";
+    ps.y_label = "stance (0/1), statistic / max|statistic|";
+    double smax = 0.0;
+    for (const auto& x : d) smax = std::max(smax, std::abs(x.statistic));
+    const std::size_t step = std::max<std::size_t>(1, d.size() / 20000);
+    PlotSeries st{"stance", PlotStyle::kSteps, {}, {}, {}, {}, "#1b9e77", 1.5};
+    PlotSeries stat{"statistic (scaled)", PlotStyle::kLines, {}, {}, {}, {}, "#7570b3", 1.0};
+    PlotSeries gait{"HMM state / 3 (A 0, B 1/3, C 2/3, D 1)", PlotStyle::kSteps, {}, {}, {}, {}, "#d95f02", 1.0};
+    for (std::size_t k = 0; k < d.size(); k += step) {
+      const double t = (*samples)[k].t.tow_s();
+      st.x.push_back(t);
+      st.y.push_back(d[k].stance ? 1.0 : 0.0);
+      stat.x.push_back(t);
+      stat.y.push_back(smax > 0 ? d[k].statistic / smax : 0.0);
+      if (d[k].gait_state >= 0) {
+        gait.x.push_back(t);
+        gait.y.push_back(d[k].gait_state / 3.0);
+      }
+    }
+    ps.series = {stat, st};
+    if (!gait.x.empty()) ps.series.push_back(gait);
+    ps.width_px = 1200;
+    if (auto ok = write_plot_svg((out / "zupt.svg").string(), ps); !ok) {
+      spdlog::warn("zupt.svg not written: {}", ok.error().message);
+    }
+  }
   if (auto ok = write_file_atomic((out / "summary.json").string(), j.dump(2) + "\n"); !ok) return ok.error();
   return sum;
 }

@@ -1,5 +1,5 @@
 // `pednav zupt CONFIG.yaml -o OUT` (run the configured zero-velocity detector over the IMU log: zupt.csv,
-// summary.json) and `pednav hmm-train CONFIG.yaml... -o hmm.yaml` (Baum-Welch over one or more logs).
+// summary.json, zupt.svg) and `pednav hmm-train CONFIG.yaml... -o hmm.yaml` (Baum-Welch over one or more logs).
 #pragma once
 
 #include <string>
@@ -24,7 +24,7 @@ struct ZuptCommandSummary {
 };
 
 /// Run the configured detector (config.zupt) over config.imu.file; writes out_dir/zupt.csv (gps_week, gps_tow_s,
-/// stance, statistic, hmm_state, hmm_grade) and out_dir/summary.json.
+/// stance, statistic, hmm_state, hmm_grade), out_dir/summary.json and the detections plot out_dir/zupt.svg (gnuplot).
 Expected<ZuptCommandSummary> run_zupt_command(const RunConfig& config, const std::string& out_dir);
 
 /// Train the HMM on the IMU logs of `configs` (all with the same hmm extraction keys), starting from the first
