@@ -1,5 +1,6 @@
 #include "fusion/engine.hpp"
 
+#include "fusion/health.hpp"
 #include "fusion/kalman.hpp"
 #include "fusion/rts.hpp"
 
@@ -39,6 +40,26 @@ struct FrameYaw {
   double var_rad2 = 0.0;
   Vector3d origin_e = Vector3d::Zero();
   Vector3d up_e = Vector3d::UnitZ();
+};
+// Divergence with a healthy-looking state and covariance (docs/robustness.md): innovations implausible for this many
+// consecutive GNSS epochs, each with at least kImplausibleMinCodeRows code rows of which more than half were rejected.
+constexpr int kImplausibleEpochs = 10;
+constexpr int kImplausibleMinCodeRows = 5;
+// Re-initialization from a GNSS epoch solution after divergence (tc mode): at most this many per run; the attitude is
+// the last healthy stance attitude, its heading may be off (wide σ), the walker's velocity is unknown.
+constexpr int kMaxReinitializations = 5;
+constexpr double kReinitSigmaYawRad = 30.0 * 3.14159265358979323846 / 180.0;
+constexpr double kReinitSigmaVelMps = 2.0;
+constexpr double kReinitSigmaPosM = 10.0;  // an epoch least-squares position (single epoch, possibly undifferenced)
+// The restart happens during a stance (foot flat and still: the last stance attitude and zero velocity hold there)
+// with a GNSS epoch solution at most this old [s] (the walker moves ~1.5 m/s: well inside kReinitSigmaPosM).
+constexpr double kReinitMaxFixAgeS = 2.0;
+
+// A GNSS epoch solution kept for a re-initialization: antenna position [m] ECEF at GPST t, satellites in the epoch.
+struct PendingFix {
+  GpsTime t;
+  Vector3d p_ea_e;
+  size_t n_sats = 0;
 };
 // GNSS update rows held in fixed-capacity matrices (32 satellites with code + Doppler); more use dynamic ones.
 constexpr int kMaxGnssRows = 64;
@@ -99,6 +120,14 @@ class Filter {
     P_.block<3, 3>(ins::kAtt.offset, ins::kAtt.offset) = Ren * att_n * Ren.transpose();
     for (const auto& b : clock_blocks_) P_(b.offset, b.offset) = 1e12;  // unknown until the first GNSS epoch
     if (o_.mode == Mode::kTightlyCoupled) P_(drift_block_.offset, drift_block_.offset) = 1e6;
+  }
+
+  // Replace the variance of a 3-state block (position [m], velocity [m/s]) by sigma² per axis, uncorrelated
+  // (re-initialization).
+  void set_block_sigma(const ins::Block& b, double sigma) {
+    P_.middleRows<3>(b.offset).setZero();
+    P_.middleCols<3>(b.offset).setZero();
+    P_.block<3, 3>(b.offset, b.offset) = Eigen::Matrix3d::Identity() * sigma * sigma;
   }
 
   // Mechanize one (already bias-corrected) increment and propagate the covariance.
@@ -248,6 +277,10 @@ class Filter {
         return false;
       }
     }
+    if (const char* defect = covariance_defect(P_)) {
+      why = defect;
+      return false;
+    }
     // A walking person stays near the Earth's surface and below vehicle speeds: anything else is divergence,
     // even while the covariance still looks healthy.
     const double r_m = x_.nav.p_eb_e.norm();
@@ -334,14 +367,15 @@ class Runner {
     return R_e_n(llh.lat, llh.lon) * o_.lever_arm_n_m;
   }
 
-  // Epoch LSQ antenna position (used for initialization and the heading fit).
-  std::optional<Vector3d> lsq_position(size_t rover_index, const Vector3d& p_init) const {
+  // Epoch LSQ antenna position (used for initialization, the heading fit and re-initialization).
+  // allow_undifferenced: an epoch without a base epoch is solved undifferenced instead of skipped.
+  std::optional<Vector3d> lsq_position(size_t rover_index, const Vector3d& p_init, bool allow_undifferenced = false) const {
     if (!in_.nav || !in_.rover) return std::nullopt;
     const gnss::ObsEpoch& re = (*in_.rover)[rover_index];
     const gnss::ObsEpoch* be = nullptr;
     if (sd_) {
-      if (matches_[rover_index].base_index < 0) return std::nullopt;
-      be = &(*in_.base)[matches_[rover_index].base_index];
+      if (matches_[rover_index].base_index >= 0) be = &(*in_.base)[matches_[rover_index].base_index];
+      else if (!allow_undifferenced) return std::nullopt;
     }
     gnss::SolverOptions so;
     so.elevation_mask_rad = o_.elevation_mask_rad;
@@ -401,8 +435,10 @@ class Runner {
     int64_t next_out_ns = ((nav0.t.ns() + out_period_ns - 1) / out_period_ns) * out_period_ns;
     size_t gi = 0;
     bool clock_initialized = false;
+    const bool gnss_pass = po.gnss && o_.mode == Mode::kTightlyCoupled && in_.rover;
     if (in_.rover) {
       while (gi < in_.rover->size() && (*in_.rover)[gi].time < nav0.t) {
+        if (gnss_pass) count(sum.gnss_skipped, "outside_imu_span", (*in_.rover)[gi].sats.size());
         ++gi;
         ++sum.gnss_epochs_before_start;
       }
@@ -414,9 +450,17 @@ class Runner {
     std::optional<StepTracker> steps;  // seed 000 step-velocity aiding (fusion/step_velocity.hpp)
     if (o_.step_velocity.enabled) steps.emplace(o_.step_velocity);
     std::string fail_message;
+    // Recovery (docs/robustness.md): after a failed health check in tc mode the filter waits for the next GNSS epoch
+    // that the epoch least squares solves and re-initializes there. The smoother cannot cross a re-initialization.
+    const bool can_reinit = gnss_pass && in_.nav;
+    bool waiting = false;
+    std::optional<PendingFix> pending;  // the latest solvable GNSS epoch while waiting
+    std::optional<GpsTime> reinitialized_at;
+    ins::InsState last_stance = f.x();  // attitude and IMU errors to restart from
+    implausible_streak_ = 0;
 
     auto on_increment = [&](const ins::ImuIncrement& inc) {
-      if (failed) return;
+      if (failed || waiting) return;
       f.predict(inc);
       ++sum.mechanization_steps;
       // ZUPT (+ ZARU) when the detector flags the sample at the interval end as stance.
@@ -436,14 +480,28 @@ class Runner {
       }
       prev_stance = stance;
       std::string why;
-      if (!f.healthy(why)) {
+      if (!f.healthy(why) || implausible_streak_ >= kImplausibleEpochs) {
+        if (why.empty()) {
+          why = "innovations implausible: " + std::to_string(implausible_streak_) +
+                " consecutive GNSS epochs with most code measurements rejected";
+        }
+        const std::string event = "filter diverged at " + inc.t1.to_string() + ": " + why;
+        sum.covariance_healthy = false;
+        sum.health_message = event;
+        sum.health_events.push_back(event);
+        if (can_reinit && sum.reinitializations < kMaxReinitializations) {
+          waiting = true;
+          return;
+        }
         failed = true;
-        fail_message = "filter diverged at " + inc.t1.to_string() + ": " + why;
+        fail_message = event;
+        if (can_reinit) fail_message += " (after " + std::to_string(kMaxReinitializations) + " re-initializations)";
         return;
       }
+      if (stance) last_stance = f.x();
       const bool output_now = inc.t1.ns() >= next_out_ns;
       // Smoother: close the run of steps at an update or an output epoch (eq. 12.13), else compose on.
-      if (smooth && (f.step_updated() || output_now)) {
+      if (smooth && !reinitialized_at && (f.step_updated() || output_now)) {
         if (segment_open) {
           f.smoother_step(step);
           acc.append(step);
@@ -455,7 +513,7 @@ class Runner {
         while (next_out_ns <= inc.t1.ns()) next_out_ns += out_period_ns;
         result.epochs.push_back(output(f.x().nav, f.P(), inc.t1, stance, last_used, last_rejected));
         last_used = last_rejected = 0;
-        if (smooth) {
+        if (smooth && !reinitialized_at) {
           if (segment_open) segments.push(acc.take());
           segment_open = true;
           nominal_at_output.push_back(f.x());
@@ -465,19 +523,53 @@ class Runner {
     };
 
     for (; sample_index < samples.size(); ++sample_index) {
-      if (po.stop && samples[sample_index].t > *po.stop) break;
+      const ins::ImuSample& raw = samples[sample_index];
+      if (po.stop && raw.t > *po.stop) break;
+      if (!raw.omega_ib_b.allFinite() || !raw.f_ib_b.allFinite()) {
+        count(sum.imu_rejected, "non_finite");
+        continue;
+      }
+      if (waiting) {
+        const bool stance_now = decisions_[std::min(sample_index, decisions_.size() - 1)].stance;
+        if (!reinitialize(f, raw.t, stance_now, gi, last_stance, pending, sum)) {
+          count(sum.imu_skipped, "filter_diverged");
+          continue;
+        }
+        waiting = false;
+        reinitialized_at = raw.t;
+        integrator = ins::IncrementIntegrator(io);  // the increments restart at this sample
+        clock_initialized = false;
+        implausible_streak_ = 0;
+        prev_stance = false;
+        last_used = last_rejected = 0;
+        if (steps) steps.emplace(o_.step_velocity);
+      }
       ++sum.imu_samples;
-      const ins::ImuSample corrected = ins::correct_sample(samples[sample_index], f.x().imu);
+      const ins::ImuSample corrected = ins::correct_sample(raw, f.x().imu);
       integrator.push(corrected, on_increment);
       if (failed) break;
     }
-    if (in_.rover && po.gnss && o_.mode == Mode::kTightlyCoupled) sum.gnss_epochs_before_start += static_cast<long>(in_.rover->size() - gi);
+    if (pending) count(sum.gnss_skipped, "filter_diverged", pending->n_sats);
+    if (gnss_pass) {
+      sum.gnss_epochs_before_start += static_cast<long>(in_.rover->size() - gi);
+      for (size_t g = gi; g < in_.rover->size(); ++g) {
+        count(sum.gnss_skipped, waiting ? "filter_diverged" : "outside_imu_span", (*in_.rover)[g].sats.size());
+      }
+    }
+    if (waiting && !failed) {
+      failed = true;
+      fail_message = sum.health_message + "; no later GNSS epoch could be solved to re-initialize";
+    }
+    if (reinitialized_at && smooth) {
+      sum.smoother_message = "not smoothed: the filter was re-initialized at " + reinitialized_at->to_string() +
+                             " (the backward pass cannot cross a re-initialization)";
+    }
     if (failed) {
       sum.covariance_healthy = false;
       sum.health_message = fail_message;
       return make_error(fail_message);
     }
-    if (smooth && !result.epochs.empty()) {
+    if (smooth && !reinitialized_at && !result.epochs.empty()) {
       // Steps after the last closed run (no updates since) end the tail at the last step.
       if (segment_open && f.run_open()) {
         f.smoother_step(step);
@@ -510,6 +602,47 @@ class Runner {
       sum.smoother_bytes = static_cast<long>(bytes);
     }
     return {};
+  }
+
+  // Re-initialization after divergence, called for each IMU sample (time t, GPST; stance: the detector's flag) while
+  // waiting: rover epochs up to t are solved by the epoch least squares, the latest solution is kept in `pending`.
+  // At a stance with a solution at most kReinitMaxFixAgeS old the filter restarts: position from GNSS (antenna -> IMU,
+  // σ >= kReinitSigmaPosM), velocity zero (σ kReinitSigmaVelMps), attitude and IMU errors of `last_stance` (a flat
+  // foot again) with a wide heading σ. A restart in mid-swing would take the stance attitude for a foot pitched by
+  // tens of degrees. Epochs passed over are counted as skipped. True if re-initialized.
+  bool reinitialize(Filter& f, GpsTime t, bool stance, size_t& gi, const ins::InsState& last_stance,
+                    std::optional<PendingFix>& pending, EngineSummary& sum) {
+    while (gi < in_.rover->size() && (*in_.rover)[gi].time <= t) {
+      const size_t n_sats = (*in_.rover)[gi].sats.size();
+      const Vector3d p_guess = pending ? pending->p_ea_e : last_stance.nav.p_eb_e + lever_e(last_stance.nav.p_eb_e);
+      const std::optional<Vector3d> pa = lsq_position(gi, p_guess, /*allow_undifferenced=*/true);
+      if (!pa) {
+        count(sum.gnss_skipped, "filter_diverged", n_sats);
+      } else {
+        if (pending) count(sum.gnss_skipped, "filter_diverged", pending->n_sats);
+        pending = PendingFix{(*in_.rover)[gi].time, *pa, n_sats};
+      }
+      ++gi;
+    }
+    if (!pending || !stance) return false;
+    if (t - pending->t > kReinitMaxFixAgeS) {
+      count(sum.gnss_skipped, "filter_diverged", pending->n_sats);
+      pending.reset();
+      return false;
+    }
+    count(sum.gnss_skipped, "reinitialization_epoch", pending->n_sats);
+    ins::NavState nav = last_stance.nav;
+    nav.t = t;
+    nav.p_eb_e = pending->p_ea_e - lever_e(pending->p_ea_e);
+    nav.v_eb_e.setZero();
+    f.init(nav, last_stance.imu, std::max(o_.initial_sigma_yaw_rad, kReinitSigmaYawRad));
+    f.set_block_sigma(ins::kVel, kReinitSigmaVelMps);
+    f.set_block_sigma(ins::kPos, std::max(o_.initial_sigma_pos_m, kReinitSigmaPosM));
+    ++sum.reinitializations;
+    sum.health_events.push_back("re-initialized at " + t.to_string() + " from the GNSS epoch solution of " +
+                                pending->t.to_string());
+    pending.reset();
+    return true;
   }
 
   // One output epoch from a nominal navigation state and the covariance of its error (forward or smoothed).
@@ -588,14 +721,14 @@ class Runner {
   }
 
   // ++m[key] without constructing a std::string for keys already present (no heap allocation per epoch).
-  static void count(std::map<std::string, long>& m, const char* key) {
+  static void count(std::map<std::string, long>& m, const char* key, size_t n = 1) {
     for (auto& [k, v] : m) {
       if (k == key) {
-        ++v;
+        v += static_cast<long>(n);
         return;
       }
     }
-    ++m[key];
+    m[key] += static_cast<long>(n);
   }
 
   // SD (or UD) pseudorange + Doppler update at rover epoch gi, processed at mechanization epoch t_proc >= epoch.
@@ -606,6 +739,7 @@ class Runner {
     if (in_.gnss_mask) {
       const size_t before = re.sats.size();
       in_.gnss_mask(re);
+      if (before > re.sats.size()) count(sum.gnss_skipped, "masked", before - re.sats.size());
       if (re.sats.empty() && before > 0) {
         ++sum.gnss_epochs_masked;
         return;
@@ -613,11 +747,13 @@ class Runner {
     }
     const gnss::ObsEpoch* be = nullptr;
     std::optional<gnss::ObsEpoch> propagated;
-    if (sd_) {
-      if (matches_[gi].base_index < 0) {
-        ++sum.gnss_epochs_skipped_no_base;
-        return;
-      }
+    // No base epoch within max_base_age_s (a base that stopped): the epoch is processed undifferenced. The clock states
+    // change meaning (rover-base vs rover clock), so they are re-initialized at every switch (docs/robustness.md).
+    const bool sd = sd_ && matches_[gi].base_index >= 0;
+    if (sd_ && !sd) ++sum.gnss_epochs_undifferenced_no_base;
+    if (last_sd_ && *last_sd_ != sd) clock_initialized = false;
+    last_sd_ = sd;
+    if (sd) {
       be = &(*in_.base)[matches_[gi].base_index];
       // An older (or later) base epoch is moved to the rover epoch with its own Doppler: the base clock drift is in
       // the Doppler, so the differential clock stays continuous across base epochs (docs/fusion.md §3).
@@ -639,7 +775,10 @@ class Runner {
     for (auto& v : code_res_by_slot) v.clear();
     for (const gnss::SatObs& so : re.sats) {
       const int slot = system_slot(o_.systems, so.sat.system);
-      if (slot < 0) continue;
+      if (slot < 0) {
+        count(sum.gnss_skipped, "system_not_configured");
+        continue;
+      }
       if (std::isnan(so.pseudorange_m)) { count(sum.code_used_rejected, "no_pseudorange"); continue; }
       if (!std::isnan(so.cn0_dbhz) && so.cn0_dbhz < o_.min_cn0_dbhz) { count(sum.code_used_rejected, "low_cn0"); continue; }
       gnss::SignalAtReceiver rs, bs;
@@ -656,7 +795,7 @@ class Runner {
       double sigma_d = gnss::measurement_sigma(o_.weights, so.cn0_dbhz, ea.elevation, true);
       if (so.sat.system == gnss::System::kGlonass) sigma_c *= o_.weights.glonass_code_factor;
       bool have_rate = o_.use_doppler && std::isfinite(rs.range_rate_mps);
-      if (sd_) {
+      if (sd) {
         auto it = std::find_if(be->sats.begin(), be->sats.end(), [&](const gnss::SatObs& b) { return b.sat == so.sat; });
         if (it == be->sats.end() || std::isnan(it->pseudorange_m)) { count(sum.code_used_rejected, "not_at_base"); continue; }
         auto sb = gnss::satellite_state_at_reception(*in_.nav, so.sat, be->time, it->pseudorange_m);
@@ -817,22 +956,29 @@ class Runner {
       active.erase(active.begin() + worst);
     }
     };
+    bool updated = false;
     if (static_cast<int>(rows.size()) <= kMaxGnssRows) {
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxGnssRows, ins::kMaxErrorDim> H;
       Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxGnssRows, 1> r;
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxGnssRows, kMaxGnssRows> R;
       solve(H, r, R);
-      if (f.update(r, H, R)) ++sum.gnss_epochs_used;
+      updated = f.update(r, H, R);
     } else {
       MatrixXd H, R;
       VectorXd r;
       solve(H, r, R);
-      if (f.update(r, H, R)) ++sum.gnss_epochs_used;
+      updated = f.update(r, H, R);
     }
+    if (updated) ++sum.gnss_epochs_used;
+    // Divergence watch: most code rows of a well-observed epoch rejected, epoch after epoch (kImplausibleEpochs).
+    const int code_rows = static_cast<int>(std::count_if(rows.begin(), rows.end(), [](const Row& w) { return !w.doppler; }));
+    if (code_rows >= kImplausibleMinCodeRows && 2 * rejected_code > code_rows) ++implausible_streak_;
+    else implausible_streak_ = 0;
+    const char* outcome = updated ? "used" : "update_failed";
     int used_code = 0;
     for (int i : active) {
-      if (rows[i].doppler) count(sum.doppler_used_rejected, "used");
-      else { count(sum.code_used_rejected, "used"); ++used_code; }
+      if (rows[i].doppler) count(sum.doppler_used_rejected, outcome);
+      else { count(sum.code_used_rejected, outcome); used_code += updated; }
     }
     used_out = used_code;
     rejected_out = rejected_code;
@@ -845,6 +991,8 @@ class Runner {
   std::vector<gnss::BaseMatch> matches_;
   bool sd_ = false;
   FrameYaw frame_;
+  std::optional<bool> last_sd_;  // differencing of the last processed GNSS epoch (SD or undifferenced)
+  int implausible_streak_ = 0;   // consecutive GNSS epochs with most code rows rejected
   // Per-epoch buffers, reused (their capacity persists: no heap allocation after the first epochs).
   gnss::ObsEpoch re_;
   std::vector<Row> rows_;
@@ -941,6 +1089,9 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
   EngineSummary& sum = result.summary;
   for (const auto& d : decisions) sum.zupt_samples += d.stance;
   if (in.rover) sum.gnss_epochs = static_cast<long>(in.rover->size());
+  if (in.rover && tc) {
+    for (const auto& e : *in.rover) sum.gnss_measurements += static_cast<long>(e.sats.size());
+  }
   Runner runner(in, o, decisions);
 
   // Initial position: configured, else the first epoch LSQ solution after the start (antenna -> IMU).
@@ -1042,6 +1193,8 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
   po.gnss = tc;
   const ins::NavState nav0 = ins::nav_state_at_rest(samples[s0].t, p0, level->roll, level->pitch, yaw0);
   if (auto ok = runner2.run(s0, nav0, imu0, po, result); !ok) return ok.error();
+  sum.imu_samples_used = sum.imu_samples;
+  if (s0 > 0) sum.imu_skipped["before_first_still_period"] += static_cast<long>(s0);
   sum.imu_samples += static_cast<long>(s0);  // samples before the start were used for levelling only
   return result;
 }

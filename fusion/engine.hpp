@@ -110,6 +110,7 @@ struct EngineSummary {
   long gnss_epochs = 0;              ///< rover epochs read
   long gnss_epochs_used = 0;         ///< epochs with at least one accepted measurement
   long gnss_epochs_skipped_no_base = 0;
+  long gnss_epochs_undifferenced_no_base = 0;  ///< SD configured but no base epoch (base stopped): processed undifferenced
   long gnss_epochs_before_start = 0; ///< before initialization / outside the IMU span
   long gnss_epochs_masked = 0;
   long clock_resets = 0;
@@ -118,8 +119,18 @@ struct EngineSummary {
   std::string initialization;        ///< how the state was initialized and when
   double heading_fit_rms_m = 0.0;
   double initial_yaw_deg = 0.0;
-  bool covariance_healthy = true;
+  bool covariance_healthy = true;    ///< false once a health check failed (even if re-initialized afterwards)
   std::string health_message;
+  // Accounting and recovery (docs/robustness.md): every IMU sample and rover measurement is used, rejected or skipped,
+  // by reason: samples: in.imu size = imu_samples_used + Σ imu_rejected + Σ imu_skipped; measurements (tc):
+  // gnss_measurements = Σ code_used_rejected (incl. "used") + Σ gnss_skipped.
+  long imu_samples_used = 0;                 ///< samples fed to the filter (from the first still period on)
+  std::map<std::string, long> imu_rejected;  ///< "non_finite"
+  std::map<std::string, long> imu_skipped;   ///< "before_first_still_period", "filter_diverged" (waiting to re-initialize)
+  long gnss_measurements = 0;                ///< satellite observations in all rover epochs (tc)
+  std::map<std::string, long> gnss_skipped;  ///< not offered to the filter: "outside_imu_span", "masked", ...
+  int reinitializations = 0;                 ///< re-initializations from a GNSS epoch solution after divergence
+  std::vector<std::string> health_events;    ///< one line per failed health check and per re-initialization
   bool smoothed = false;             ///< the RTS smoother ran (EngineResult::smoothed filled)
   long smoother_records = 0;         ///< stored backward maps (one per output epoch)
   long smoother_bytes = 0;           ///< heap bytes of the stored backward maps + nominal states at the outputs

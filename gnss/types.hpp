@@ -51,7 +51,9 @@ struct ObsReadStats {
   int event_records = 0;       ///< epoch flags 2-5 (moving antenna, new site, header info, external event)
   int power_failure_epochs = 0;///< epoch flag 1
   int sats_without_signal = 0; ///< satellite records lacking the selected signal
-  bool truncated = false;      ///< the last epoch record was incomplete
+  bool truncated = false;      ///< the last epoch record was incomplete (or the file ends inside a line)
+  bool last_epoch_dropped = false;  ///< the file ended inside the last epoch's data: that epoch was dropped
+  int records_out_of_range = 0;///< satellite records dated before 1980-01-06 or after 2106 (garbage dates): dropped
 };
 
 /// An observation file as pednav sees it.

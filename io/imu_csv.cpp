@@ -117,6 +117,10 @@ Expected<ImuLog> parse_imu_csv(const char* data, size_t size, const std::string&
       continue;
     }
     ++rep.rows;
+    if (le == end) {  // the file ends inside this line: "0.0123" may be the start of "0.012345" (truncation)
+      ++rep.truncated_rows;
+      break;
+    }
     // Split and parse the needed columns.
     const char* f = p;
     bool ok = true;
@@ -276,6 +280,9 @@ Expected<ImuLog> parse_imu_csv(const char* data, size_t size, const std::string&
     return make_error(name + ": angular rate reaches " + num(rep.max_gyro_norm_radps, "%.4g") +
                       " rad/s, beyond any foot IMU: gyro.unit is probably deg_per_s, not rad_per_s");
   }
+  if (rep.truncated_rows)
+    rep.warnings.push_back("the last line (" + name + ":" + std::to_string(line) +
+                           ") has no line end: the file was cut off; that row was dropped");
   if (rep.duplicates_dropped)
     rep.warnings.push_back(std::to_string(rep.duplicates_dropped) + " duplicate time stamps dropped (" +
                            std::to_string(rep.duplicates_differing) + " with differing values)");

@@ -54,6 +54,7 @@ struct ImuLogReport {
   long duplicates_differing = 0; ///< ... of which the values differ from the kept row
   long bad_rows = 0;             ///< rows dropped for NaN / empty / unparsable fields
   long first_bad_line = 0;       ///< file line of the first such row (1-based), 0 = none
+  long truncated_rows = 0;       ///< a last row without a line end (file cut off): dropped, its numbers may be cut
   long saturated_samples = 0;    ///< samples with any axis at >= 99.9 % of the configured full scale
   long above_full_scale = 0;     ///< samples beyond the configured full scale (impossible: the range setting is wrong)
   long gaps = 0;                 ///< time steps longer than gap_factor x median step

@@ -47,6 +47,37 @@ SolutionRow to_row(const fusion::EpochOutput& e) {
   return r;
 }
 
+// read = used + rejected (by reason) + skipped (by reason), for IMU rows and rover measurements (docs/robustness.md).
+nlohmann::ordered_json accounting_json(const ImuLog& imu, const RunInputs& data, const fusion::EngineSummary& sum, bool tc) {
+  nlohmann::ordered_json a;
+  std::map<std::string, long> imu_rejected = sum.imu_rejected;
+  if (imu.report.bad_rows) imu_rejected["unparsable_or_non_finite_row"] += imu.report.bad_rows;
+  if (imu.report.duplicates_dropped) imu_rejected["duplicate_time"] += imu.report.duplicates_dropped;
+  std::map<std::string, long> imu_skipped = sum.imu_skipped;
+  if (imu.report.truncated_rows) imu_skipped["truncated_last_row"] += imu.report.truncated_rows;
+  a["imu_samples"] = {{"read", imu.report.rows},
+                      {"used", sum.imu_samples_used},
+                      {"rejected", imu_rejected},
+                      {"skipped", imu_skipped}};
+  if (!tc) return a;
+  std::map<std::string, long> rejected = sum.code_used_rejected;
+  const long used = rejected.count("used") ? rejected.at("used") : 0;
+  rejected.erase("used");
+  a["gnss_measurements"] = {{"read", sum.gnss_measurements},
+                            {"used", used},
+                            {"rejected", rejected},
+                            {"skipped", sum.gnss_skipped}};
+  if (data.rover) {
+    a["rover_obs"] = {{"truncated", data.rover->stats.truncated},
+                      {"last_epoch_dropped", data.rover->stats.last_epoch_dropped}};
+  }
+  if (data.base) {
+    a["base_obs"] = {{"truncated", data.base->stats.truncated},
+                     {"last_epoch_dropped", data.base->stats.last_epoch_dropped}};
+  }
+  return a;
+}
+
 }  // namespace
 
 fusion::EngineOptions engine_options(const RunConfig& c) {
@@ -132,6 +163,12 @@ Expected<RunInputs> load_run_inputs(const RunConfig& c) {
   auto r = gnss::read_rinex_obs(c.gnss.rover_obs, sel);
   if (!r) return r.error();
   d.rover = std::move(*r);
+  auto warn_truncated = [](const std::string& path, const gnss::ObsReadStats& st) {
+    if (!st.truncated) return;
+    spdlog::warn("{}: truncated: the last epoch record is incomplete (file cut off?){}", path,
+                 st.last_epoch_dropped ? "; that epoch was dropped" : "");
+  };
+  warn_truncated(c.gnss.rover_obs, d.rover->stats);
   auto n = gnss::read_rinex_nav(c.gnss.nav);
   if (!n) return n.error();
   d.nav = std::move(*n);
@@ -139,6 +176,7 @@ Expected<RunInputs> load_run_inputs(const RunConfig& c) {
     auto b = gnss::read_rinex_obs(c.gnss.base_obs, sel);
     if (!b) return b.error();
     d.base = std::move(*b);
+    warn_truncated(c.gnss.base_obs, d.base->stats);
     if (c.gnss.base_position_ecef_m) {
       d.options.base_position_e = c.gnss.base_position_ecef_m;
     } else if (d.base->has_approx_position) {
@@ -220,6 +258,7 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
     j["gnss"] = {{"epochs_read", sum.gnss_epochs},
                  {"epochs_used", sum.gnss_epochs_used},
                  {"epochs_skipped_no_base", sum.gnss_epochs_skipped_no_base},
+                 {"epochs_undifferenced_no_base", sum.gnss_epochs_undifferenced_no_base},
                  {"epochs_outside_imu_span", sum.gnss_epochs_before_start},
                  {"epochs_masked", sum.gnss_epochs_masked},
                  {"clock_resets", sum.clock_resets},
@@ -233,6 +272,11 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
                    {"stored_bytes", sum.smoother_bytes}};
   if (!sum.smoother_message.empty()) j["smoother"]["message"] = sum.smoother_message;
   j["covariance_healthy"] = sum.covariance_healthy;
+  j["health"] = {{"healthy", sum.covariance_healthy},
+                 {"reinitializations", sum.reinitializations},
+                 {"events", sum.health_events}};
+  for (const auto& e : sum.health_events) spdlog::warn("{}", e);
+  j["accounting"] = accounting_json(*imu, data, sum, opt.mode == fusion::Mode::kTightlyCoupled);
   j["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   if (!c.reference.file.empty()) {

@@ -87,31 +87,55 @@ Expected<void> check_readable(const std::string& path) {
   return {};
 }
 
+// True when the file's last byte is a line end (a file cut off by a dying battery usually ends inside a line).
+bool ends_with_newline(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return true;
+  const bool ok = std::fseek(f, -1, SEEK_END) == 0 && std::fgetc(f) == '\n';
+  std::fclose(f);
+  return ok;
+}
+
 // Cheap pre-scan of a RINEX 3 observation body (RTKLIB silently skips event records and stops at a truncated
 // record): counts epoch flags 1 and 2-5 and detects a last epoch record with fewer satellite lines than announced.
 // RINEX 2 files are not scanned (their epoch lines cannot be told from data lines without decoding).
-void prescan_rinex3(const std::string& path, ObsReadStats& stats) {
+// Truncation (docs/robustness.md): RTKLIB drops a record whose satellite lines stop at the end of the file, but
+// when the file ends inside the LAST satellite line of a record, RTKLIB decodes the cut numbers ("2012" from
+// "20123456.789") and returns the record. `cut_inside_record` is set for that case (and, for RINEX 2, whenever the
+// file does not end with a line end) so that the caller drops the last epoch.
+void prescan_rinex3(const std::string& path, ObsReadStats& stats, bool& cut_inside_record) {
+  const bool complete_last_line = ends_with_newline(path);
+  cut_inside_record = false;
   std::FILE* f = std::fopen(path.c_str(), "r");
   if (!f) return;
   char buf[1024];
   bool header = true;
   int expected_lines = 0;  // satellite/header lines still due for the current record
   bool in_record = false;
+  bool last_is_epoch_line = false;
+  bool rinex2 = false;
   while (std::fgets(buf, sizeof buf, f)) {
     const std::string line(buf);
+    if (!line.empty() && line.back() != '\n' && !std::feof(f)) {  // an over-long line: skip the rest of it
+      int c;
+      while ((c = std::fgetc(f)) != EOF && c != '\n') {
+      }
+    }
     if (header) {
       if (line.find("RINEX VERSION / TYPE") != std::string::npos && line.size() > 5 && line.find_first_not_of(' ') < 9 &&
           std::atof(line.substr(0, 9).c_str()) < 3.0) {
-        std::fclose(f);
-        return;
+        rinex2 = true;
+        break;
       }
       if (line.find("END OF HEADER") != std::string::npos) header = false;
       continue;
     }
     if (expected_lines > 0) {
       --expected_lines;
+      last_is_epoch_line = false;
       continue;
     }
+    last_is_epoch_line = !line.empty() && line[0] == '>';
     if (line.empty() || line[0] != '>' || line.size() < 35) continue;
     const int flag = line[31] - '0';
     const int n = std::atoi(line.substr(32, 3).c_str());
@@ -120,8 +144,14 @@ void prescan_rinex3(const std::string& path, ObsReadStats& stats) {
     expected_lines = n;
     in_record = true;
   }
-  stats.truncated = in_record && expected_lines > 0;
   std::fclose(f);
+  if (rinex2) {
+    stats.truncated = !complete_last_line;
+    cut_inside_record = !complete_last_line;
+    return;
+  }
+  stats.truncated = (in_record && expected_lines > 0) || !complete_last_line;
+  cut_inside_record = !complete_last_line && expected_lines == 0 && !last_is_epoch_line && in_record;
 }
 
 }  // namespace
@@ -148,7 +178,10 @@ Expected<ObsData> read_rinex_obs(const std::string& path, const SystemSelection&
 
   for (int i = 0; i < obs->n; ++i) {
     const obsd_t& d = obs->data[i];
-    if (!in_range(d.time)) continue;  // a garbage date: dropped
+    if (!in_range(d.time)) {
+      ++out.stats.records_out_of_range;
+      continue;
+    }
     const GpsTime t = from_gtime(d.time);
     if (out.epochs.empty() || std::abs(t - out.epochs.back().time) > 1e-6) {
       out.epochs.push_back(ObsEpoch{t, {}});
@@ -172,9 +205,16 @@ Expected<ObsData> read_rinex_obs(const std::string& path, const SystemSelection&
     }
     out.epochs.back().sats.push_back(so);
   }
-  if (out.epochs.empty()) return make_error(path + ": no usable observation epoch");
+  bool cut_inside_record = false;
+  prescan_rinex3(path, out.stats, cut_inside_record);
+  if (cut_inside_record && !out.epochs.empty()) {
+    out.epochs.pop_back();  // its last satellite line was cut: the numbers in it are not the receiver's
+    out.stats.last_epoch_dropped = true;
+  }
+  if (out.epochs.empty()) {
+    return make_error(path + (out.stats.truncated ? ": truncated: no complete observation epoch" : ": no usable observation epoch"));
+  }
   out.stats.epochs_read = static_cast<int>(out.epochs.size());
-  prescan_rinex3(path, out.stats);
   return out;
 }
 

@@ -2,8 +2,12 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "core/geodesy.hpp"
 #include "fusion/engine.hpp"
+#include "fusion/health.hpp"
 #include "ins/imu_spec.hpp"
 #include "io/config.hpp"
 #include "io/run_command.hpp"
@@ -40,6 +44,29 @@ TEST(EngineHealth, ImplausibleSpeedIsReportedAsDivergence) {
   ASSERT_FALSE(r) << "a 300 m/s foot must not come out as a healthy trajectory";
   EXPECT_THAT(r.error().message, HasSubstr("filter diverged at"));
   EXPECT_THAT(r.error().message, HasSubstr("a walking person stays below 100 m/s"));
+}
+
+// The covariance check of the health test (fusion/health.hpp): a healthy P passes; asymmetry, indefiniteness and
+// non-finite entries are named.
+TEST(EngineHealth, CovarianceDefectsAreNamed) {
+  constexpr int kDim = 17;
+  ins::ErrorMatrix P = ins::ErrorMatrix::Identity(kDim, kDim);
+  P.block<3, 3>(0, 0) *= 1e4;  // position [m²] next to attitude [rad²]: the check works on correlations
+  P.block<3, 3>(6, 6) *= 1e-6;
+  P(0, 6) = P(6, 0) = 0.9 * std::sqrt(P(0, 0) * P(6, 6));  // a strong but valid correlation
+  EXPECT_EQ(fusion::covariance_defect(P), nullptr);
+  ins::ErrorMatrix A = P;
+  A(1, 2) += 1e-6 * A(0, 0);  // relative asymmetry 1e-6 > kMaxRelativeAsymmetry
+  ASSERT_NE(fusion::covariance_defect(A), nullptr);
+  EXPECT_THAT(fusion::covariance_defect(A), HasSubstr("not symmetric"));
+  ins::ErrorMatrix N = P;
+  N(0, 6) = N(6, 0) = 1.5 * std::sqrt(P(0, 0) * P(6, 6));  // a correlation of 1.5: no covariance has it
+  ASSERT_NE(fusion::covariance_defect(N), nullptr);
+  EXPECT_THAT(fusion::covariance_defect(N), HasSubstr("not positive semi-definite"));
+  ins::ErrorMatrix F = P;
+  F(3, 3) = std::numeric_limits<double>::quiet_NaN();
+  ASSERT_NE(fusion::covariance_defect(F), nullptr);
+  EXPECT_THAT(fusion::covariance_defect(F), HasSubstr("non-finite"));
 }
 
 TEST(EngineHealth, RunWithoutImuSpecIsAConfigError) {

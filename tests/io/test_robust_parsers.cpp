@@ -62,6 +62,43 @@ void expect_finite_and_increasing(const ImuLog& log) {
   }
 }
 
+// Truncation at every byte offset of the data (many of them mid-line): either an error naming the file, or a log
+// whose rows are a prefix of the full log's, with the cut row reported and dropped.
+TEST(RobustImuFault, TruncationAtEveryOffsetCompletesWithTruncationReportedOrFailsClearly) {
+  const std::string full = walk_csv();
+  auto whole = parse(full);
+  ASSERT_TRUE(whole) << whole.error().message;
+  ASSERT_EQ(whole->report.truncated_rows, 0);
+  int ok = 0, failed = 0, reported = 0;
+  for (size_t cut = 1; cut < full.size(); ++cut) {
+    auto log = parse(full.substr(0, cut));
+    if (!log) {
+      ++failed;
+      EXPECT_THAT(log.error().message, HasSubstr("imu.csv")) << "cut at " << cut;
+      continue;
+    }
+    ++ok;
+    expect_finite_and_increasing(*log);
+    ASSERT_LE(log->samples.size(), whole->samples.size());
+    for (size_t i = 0; i < log->samples.size(); ++i) {
+      ASSERT_EQ(log->samples[i].t, whole->samples[i].t) << "cut at " << cut;
+      ASSERT_EQ(log->samples[i].omega_ib_b, whole->samples[i].omega_ib_b) << "cut at " << cut << ": a cut number was kept";
+      ASSERT_EQ(log->samples[i].f_ib_b, whole->samples[i].f_ib_b) << "cut at " << cut << ": a cut number was kept";
+    }
+    const bool mid_line = full[cut - 1] != '\n';
+    EXPECT_EQ(log->report.truncated_rows, mid_line ? 1 : 0) << "cut at " << cut;
+    if (mid_line) {
+      ++reported;
+      std::string all;
+      for (const auto& w : log->report.warnings) all += w;
+      EXPECT_THAT(all, HasSubstr("has no line end: the file was cut off")) << "cut at " << cut;
+    }
+  }
+  EXPECT_GT(ok, 0);
+  EXPECT_GT(failed, 0);  // cuts in the first rows leave too few samples
+  EXPECT_GT(reported, 0);
+}
+
 TEST(RobustImuFault, NanAndInfFieldsAreDroppedAndCounted) {
   std::string text = walk_csv();
   for (const char* bad : {"nan", "inf", "-inf", "NaN", "1e999", ""}) {

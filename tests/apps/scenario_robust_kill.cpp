@@ -1,0 +1,143 @@
+// Atomic outputs (issue 11, docs/robustness.md): `pednav run` killed by a signal at random moments (fixed seed) leaves
+// no partial file under a final name: every output present is identical to the one of an undisturbed run
+// (summary.json: apart from its wall-clock time). Temporary "<name>.tmp.<pid>" files may remain after SIGKILL.
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <string>
+#include <thread>
+
+#include "io/simulate_command.hpp"
+#include "tests/sim/fixtures.hpp"
+
+namespace pednav {
+namespace {
+
+constexpr int kKills = 30;  // 10 per signal
+constexpr unsigned kSeed = 2026;
+constexpr double kRunTimeout_s = 120.0;
+
+constexpr const char* kWalkYaml = R"(
+name: robust_kill
+seed: 9
+start: {gps_week: 2300, gps_tow_s: 510000}
+origin: {lat_deg: 52.2, lon_deg: 0.1, h_m: 20}
+route:
+  static_start_s: 20
+  static_end_s: 5
+  shape: {type: rectangle, east_m: 30, north_m: 20, laps: 2}
+gait: {speed_mps: 1.2, cycle_s: 1.1}
+imu: {rate_hz: 100, spec: crista, errors: true}
+gnss: {base_offset_enu_m: [100, 50, 2]}
+output: {truth_rate_hz: 10}
+)";
+
+// Start `pednav run config -o out` as a child process; returns its pid.
+pid_t start_run(const std::string& config, const std::string& out) {
+  const std::string exe = std::string(PEDNAV_BINARY_DIR) + "/bin/pednav";
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int devnull = ::open("/dev/null", O_WRONLY);
+    ::dup2(devnull, 1);
+    ::dup2(devnull, 2);
+    ::execl(exe.c_str(), exe.c_str(), "run", config.c_str(), "-o", out.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  return pid;
+}
+
+// Wait for the child; returns its exit status (or -signal).
+int wait_run(pid_t pid) {
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+}
+
+// An output as compared: the output folder's path replaced by "OUT" (evaluation files name the solution file), and
+// summary.json without its wall-clock time.
+std::string normalized(const std::string& name, std::string text, const std::string& out_dir) {
+  for (size_t at = text.find(out_dir); at != std::string::npos; at = text.find(out_dir, at + 3)) {
+    text.replace(at, out_dir.size(), "OUT");
+  }
+  if (name != "summary.json") return text;
+  auto j = nlohmann::json::parse(text);
+  j.erase("wall_s");
+  return j.dump();
+}
+
+TEST(RobustAtomicOutputs, KilledRunLeavesNoPartialFileUnderAFinalName) {
+  const std::string exe = std::string(PEDNAV_BINARY_DIR) + "/bin/pednav";
+  ASSERT_TRUE(std::filesystem::exists(exe)) << exe;
+  const std::string dir = test::temp_dir("robust_kill");
+  auto sim = io::run_simulate_command(test::scenario_from_text(kWalkYaml), dir);
+  ASSERT_TRUE(sim.has_value()) << sim.error().message;
+  std::string cfg = test::read_text(dir + "/config.yaml");
+  const auto m = cfg.find("mode: gnss");
+  ASSERT_NE(m, std::string::npos) << cfg;
+  cfg.replace(m, 10, "mode: tc");
+  const std::string config = dir + "/run.yaml";
+  std::ofstream(config) << cfg;
+
+  // The undisturbed run: its outputs and its duration.
+  const std::string ref = dir + "/ref";
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(wait_run(start_run(config, ref)), 0) << "pednav run " << config << " failed";
+  const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_LT(run_s, kRunTimeout_s);
+  std::map<std::string, std::string> expected;
+  for (const auto& e : std::filesystem::directory_iterator(ref)) {
+    const std::string name = e.path().filename().string();
+    ASSERT_EQ(name.find(".tmp."), std::string::npos) << "leftover of a completed run: " << name;
+    expected[name] = normalized(name, test::read_text(e.path().string()), ref);
+  }
+  ASSERT_TRUE(expected.count("solution.csv") && expected.count("summary.json"));
+
+  std::mt19937 rng(kSeed);
+  // Most kills in the second half of the run, where the outputs are written; some come after the end (nothing to kill).
+  std::uniform_real_distribution<double> when(0.3 * run_s, 1.1 * run_s);
+  const int signals[] = {SIGKILL, SIGTERM, SIGINT};
+  int killed = 0, partial_sets = 0, with_outputs = 0, with_temporaries = 0;
+  for (int k = 0; k < kKills; ++k) {
+    const std::string out = dir + "/out_" + std::to_string(k);
+    const pid_t pid = start_run(config, out);
+    std::this_thread::sleep_for(std::chrono::duration<double>(when(rng)));
+    const int sig = signals[k % 3];
+    ::kill(pid, sig);
+    const int status = wait_run(pid);
+    killed += status < 0;
+    if (!std::filesystem::exists(out)) continue;
+    size_t finals = 0;
+    bool temporaries = false;
+    for (const auto& e : std::filesystem::directory_iterator(out)) {
+      const std::string name = e.path().filename().string();
+      if (name.find(".tmp.") != std::string::npos) {  // the temporary name: allowed after a kill
+        temporaries = true;
+        continue;
+      }
+      ++finals;
+      ASSERT_TRUE(expected.count(name)) << "unexpected output " << name;
+      const std::string got = normalized(name, test::read_text(e.path().string()), out);
+      ASSERT_EQ(got.size(), expected[name].size()) << "kill " << k << " (signal " << sig << "): partial " << name;
+      ASSERT_TRUE(got == expected[name]) << "kill " << k << " (signal " << sig << "): " << name << " differs";
+    }
+    partial_sets += status < 0 && finals > 0 && finals < expected.size();
+    with_outputs += status < 0 && finals > 0;
+    with_temporaries += temporaries;
+  }
+  std::printf("[ robust ] %d runs, %d killed by the signal: %d of them after the first output was complete (%d with "
+              "only part of the outputs), %d left a temporary file; run alone %.2f s\n",
+              kKills, killed, with_outputs, partial_sets, with_temporaries, run_s);
+  EXPECT_GE(killed, kKills / 2);
+}
+
+}  // namespace
+}  // namespace pednav

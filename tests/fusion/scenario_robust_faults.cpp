@@ -1,0 +1,380 @@
+// Fault injection into the tightly coupled engine (issue 11, docs/robustness.md): a simulated open-sky walk with a
+// base, one fault per test (receiver clock jump, pseudorange blunder, missing ephemeris, base that stops, IMU garbage
+// that makes the filter diverge, non-finite samples, 10 minutes without satellites). Each run must complete without
+// NaN, say what happened in the summary, and stay accurate (or recover); every input is accounted for.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "core/geodesy.hpp"
+#include "core/rotation.hpp"
+#include "fusion/engine.hpp"
+#include "io/config.hpp"
+#include "io/run_command.hpp"
+#include "io/scenario_config.hpp"
+#include "sim/simulator.hpp"
+
+namespace pednav {
+namespace {
+
+using ::testing::HasSubstr;
+using Eigen::Vector3d;
+
+// Open sky, one lap of a 60 m x 40 m rectangle (about 3.5 min); the long variant walks 5 laps (about 14 min).
+constexpr const char* kWalkYaml = R"(
+name: robust_walk
+seed: 31
+start: {gps_week: 2300, gps_tow_s: 400000}
+origin: {lat_deg: 46.5, lon_deg: 6.6, h_m: 400}
+route:
+  static_start_s: 30
+  static_end_s: 10
+  shape: {type: rectangle, east_m: 60, north_m: 40, laps: LAPS}
+gait: {speed_mps: 1.2, cycle_s: 1.1}
+imu: {rate_hz: 100, spec: crista, errors: true}
+gnss:
+  base_offset_enu_m: [200, 100, 3]
+)";
+
+constexpr double kSpeedOfLight_mps = 299792458.0;
+constexpr double kClockJump_s = 1e-3;           // issue 11: a 1 ms receiver clock jump
+constexpr double kBlunder_m = 300.0;            // issue 11: a 300 m pseudorange blunder on one satellite
+constexpr double kBlunderDuration_s = 60.0;
+constexpr double kOutage_s = 600.0;             // issue 11: 10 minutes without satellites
+constexpr double kMaxRmsNoFault_m = 2.0;        // forward TC on this walk (measured: see the printout)
+constexpr double kMaxRmsWithFault_m = 2.5;      // a handled fault costs little accuracy
+constexpr double kMaxErrorAfterRecovery_m = 5.0;// error from 60 s after a recovery / the end of an outage
+constexpr double kRecoveryTime_s = 60.0;
+constexpr double kMaxOutputGap_s = 1.0 + 1e-6;  // 1 Hz output
+constexpr double kMaxErrorUndifferenced_m = 10.0;
+constexpr double kWrongStart_m = 300.0;           // configured start position this far off (north) ...
+constexpr double kConfidentSigma_m = 0.05;        // ... with this initial position sigma  // after the base stops: undifferenced code, broadcast corrections
+
+struct Walk {
+  sim::Simulation sim;
+  fusion::EngineOptions options;
+};
+
+Walk make_walk(int laps) {
+  std::string text = kWalkYaml;
+  text.replace(text.find("LAPS"), 4, std::to_string(laps));
+  auto file = io::parse_scenario(text, "robust_walk.yaml", ".");
+  EXPECT_TRUE(file.has_value()) << (file ? "" : file.error().message);
+  auto s = sim::simulate(file->scenario);
+  EXPECT_TRUE(s.has_value()) << (s ? "" : s.error().message);
+  Walk w{std::move(*s), {}};
+  io::RunConfig c;  // the configuration `pednav simulate` writes, mode tc
+  c.mode = "tc";
+  c.imu.spec = file->scenario.imu.spec;
+  w.options = io::engine_options(c);
+  w.options.base_position_e = w.sim.gnss.p_base_e;
+  w.options.smoother_enabled = false;
+  return w;
+}
+
+Walk& short_walk() {
+  static Walk w = make_walk(1);
+  return w;
+}
+
+struct Inputs {
+  std::vector<ins::ImuSample> imu;
+  std::vector<gnss::ObsEpoch> rover, base;
+  gnss::NavData nav;
+};
+
+Inputs inputs_of(const Walk& w) { return {w.sim.imu, w.sim.gnss.rover.epochs, w.sim.gnss.base.epochs, w.sim.nav}; }
+
+Expected<fusion::EngineResult> run(const Walk& w, const Inputs& in, const fusion::EngineOptions& o) {
+  fusion::EngineInputs ei;
+  ei.imu = &in.imu;
+  ei.nav = &in.nav;
+  ei.rover = &in.rover;
+  ei.base = in.base.empty() ? nullptr : &in.base;
+  fusion::EngineOptions opt = o;
+  if (in.base.empty()) opt.base_position_e.reset();
+  (void)w;
+  return fusion::run_forward(ei, opt);
+}
+
+// Horizontal errors [m] of the forward solution against the truth (all outputs, and those from t_from on).
+struct Errors {
+  double rms = 0, max = 0, max_from = 0;
+  long n = 0;
+};
+
+Errors errors(const Walk& w, const fusion::EngineResult& r, GpsTime t_from) {
+  const auto& nav = w.sim.truth.nav;
+  const double rate = w.sim.scenario.imu.rate_hz;
+  Errors e;
+  double ss = 0;
+  for (const auto& out : r.epochs) {
+    EXPECT_TRUE(out.nav.p_eb_e.allFinite() && out.nav.v_eb_e.allFinite() && out.cov_p_n.allFinite())
+        << out.t.to_string();
+    const long i = std::lround((out.t - nav.front().t) * rate);
+    if (i < 0 || i >= static_cast<long>(nav.size())) continue;
+    const double d = enu_from_ecef(out.nav.p_eb_e, nav[i].p_eb_e).head<2>().norm();
+    ss += d * d;
+    e.max = std::max(e.max, d);
+    if (out.t >= t_from) e.max_from = std::max(e.max_from, d);
+    ++e.n;
+  }
+  e.rms = e.n ? std::sqrt(ss / static_cast<double>(e.n)) : 0.0;
+  return e;
+}
+
+long sum_of(const std::map<std::string, long>& m) {
+  return std::accumulate(m.begin(), m.end(), 0L, [](long a, const auto& kv) { return a + kv.second; });
+}
+
+// read = used + rejected (by reason) + skipped (by reason), for IMU samples and rover measurements.
+void expect_accounting(const Inputs& in, const fusion::EngineSummary& s) {
+  EXPECT_EQ(static_cast<long>(in.imu.size()), s.imu_samples_used + sum_of(s.imu_rejected) + sum_of(s.imu_skipped));
+  long sats = 0;
+  for (const auto& e : in.rover) sats += static_cast<long>(e.sats.size());
+  EXPECT_EQ(s.gnss_measurements, sats);
+  EXPECT_EQ(s.gnss_measurements, sum_of(s.code_used_rejected) + sum_of(s.gnss_skipped));
+}
+
+GpsTime mid_time(const Walk& w) {
+  const auto& r = w.sim.gnss.rover.epochs;
+  return r[r.size() / 2].time;
+}
+
+// The satellite seen in the most rover epochs (a high one for most of the walk).
+gnss::SatId busiest_sat(const Inputs& in) {
+  std::map<std::pair<int, int>, int> n;
+  for (const auto& e : in.rover)
+    for (const auto& s : e.sats) ++n[{static_cast<int>(s.sat.system), s.sat.prn}];
+  auto best = std::max_element(n.begin(), n.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+  return gnss::SatId{static_cast<gnss::System>(best->first.first), best->first.second};
+}
+
+long count_of(const std::map<std::string, long>& m, const std::string& key) {
+  auto it = m.find(key);
+  return it == m.end() ? 0 : it->second;
+}
+
+TEST(RobustGnssFault, NoFaultBaselineIsAccurateAndAccountsForEveryInput) {
+  Walk& w = short_walk();
+  const Inputs in = inputs_of(w);
+  auto r = run(w, in, w.options);
+  ASSERT_TRUE(r) << r.error().message;
+  const Errors e = errors(w, *r, GpsTime{});
+  std::printf("[ robust ] no fault: %ld epochs, horizontal RMS %.2f m, max %.2f m\n", e.n, e.rms, e.max);
+  EXPECT_LT(e.rms, kMaxRmsNoFault_m);
+  EXPECT_TRUE(r->summary.covariance_healthy) << r->summary.health_message;
+  EXPECT_EQ(r->summary.reinitializations, 0);
+  expect_accounting(in, r->summary);
+}
+
+TEST(RobustGnssFault, ReceiverClockJumpOf1msResetsTheClock) {
+  Walk& w = short_walk();
+  Inputs in = inputs_of(w);
+  const GpsTime t_jump = mid_time(w);
+  for (auto& e : in.rover) {
+    if (e.time < t_jump) continue;
+    for (auto& s : e.sats) s.pseudorange_m += kSpeedOfLight_mps * kClockJump_s;  // 299.8 km on every satellite
+  }
+  auto r = run(w, in, w.options);
+  ASSERT_TRUE(r) << r.error().message;
+  const Errors e = errors(w, *r, t_jump);
+  std::printf("[ robust ] 1 ms clock jump: RMS %.2f m, max after the jump %.2f m, %ld clock resets\n", e.rms, e.max_from,
+              r->summary.clock_resets);
+  EXPECT_GE(r->summary.clock_resets, 1);
+  EXPECT_LT(e.rms, kMaxRmsWithFault_m);
+  EXPECT_TRUE(r->summary.covariance_healthy) << r->summary.health_message;
+  expect_accounting(in, r->summary);
+}
+
+TEST(RobustGnssFault, PseudorangeBlunderOf300mOnOneSatelliteIsRejected) {
+  Walk& w = short_walk();
+  Inputs in = inputs_of(w);
+  const gnss::SatId bad = busiest_sat(in);
+  const GpsTime t0 = mid_time(w);
+  long blundered = 0;
+  for (auto& e : in.rover) {
+    if (e.time < t0 || e.time - t0 > kBlunderDuration_s) continue;
+    for (auto& s : e.sats) {
+      if (s.sat == bad && !std::isnan(s.pseudorange_m)) {
+        s.pseudorange_m += kBlunder_m;
+        ++blundered;
+      }
+    }
+  }
+  ASSERT_GT(blundered, 50);
+  auto r = run(w, in, w.options);
+  ASSERT_TRUE(r) << r.error().message;
+  const Errors e = errors(w, *r, t0);
+  const long faults = count_of(r->summary.code_used_rejected, "innovation_fault");
+  std::printf("[ robust ] 300 m blunder on %ld epochs: %ld code rejections, RMS %.2f m, max after %.2f m\n", blundered,
+              faults, e.rms, e.max_from);
+  EXPECT_GE(faults, blundered);
+  EXPECT_LT(e.rms, kMaxRmsWithFault_m);
+  expect_accounting(in, r->summary);
+}
+
+TEST(RobustGnssFault, MissingEphemerisOfOneSatelliteIsCountedAndTheRestUsed) {
+  Walk& w = short_walk();
+  Inputs in = inputs_of(w);
+  const gnss::SatId gone = busiest_sat(in);
+  std::erase_if(in.nav.kepler, [&](const gnss::KeplerEphemeris& k) { return k.sat == gone; });
+  auto r = run(w, in, w.options);
+  ASSERT_TRUE(r) << r.error().message;
+  const Errors e = errors(w, *r, GpsTime{});
+  const long missing = count_of(r->summary.code_used_rejected, "no_ephemeris");
+  std::printf("[ robust ] no ephemeris for one satellite: %ld measurements without, RMS %.2f m\n", missing, e.rms);
+  EXPECT_GT(missing, 100);
+  EXPECT_LT(e.rms, kMaxRmsWithFault_m);
+  expect_accounting(in, r->summary);
+}
+
+TEST(RobustGnssFault, BaseThatStopsIsReportedAndTheRunContinues) {
+  Walk& w = short_walk();
+  Inputs in = inputs_of(w);
+  const GpsTime t_stop = mid_time(w);
+  std::erase_if(in.base, [&](const gnss::ObsEpoch& e) { return e.time > t_stop; });
+  auto r = run(w, in, w.options);
+  ASSERT_TRUE(r) << r.error().message;
+  const Errors e = errors(w, *r, t_stop);
+  const auto& s = r->summary;
+  std::printf("[ robust ] base stops at mid-walk: %ld rover epochs undifferenced, RMS %.2f m, max after %.2f m\n",
+              s.gnss_epochs_undifferenced_no_base, e.rms, e.max_from);
+  EXPECT_GT(s.gnss_epochs_undifferenced_no_base, 30);  // processed undifferenced (broadcast clock, Klobuchar, Saastamoinen)
+  EXPECT_LT(e.max_from, kMaxErrorUndifferenced_m);
+  EXPECT_TRUE(s.covariance_healthy) << s.health_message;
+  ASSERT_FALSE(r->epochs.empty());
+  EXPECT_LE(w.sim.imu.back().t - r->epochs.back().t, kMaxOutputGap_s);  // the solution goes on to the end
+  for (size_t k = 1; k < r->epochs.size(); ++k) ASSERT_LE(r->epochs[k].t - r->epochs[k - 1].t, kMaxOutputGap_s);
+  expect_accounting(in, r->summary);
+}
+
+TEST(RobustHealth, DivergenceFromImuGarbageIsReportedAndReinitializedFromGnss) {
+  Walk& w = short_walk();
+  Inputs in = inputs_of(w);
+  const GpsTime t0 = mid_time(w);
+  long hit = 0;
+  for (auto& s : in.imu) {
+    if (s.t < t0 || s.t - t0 > 2.0) continue;
+    s.f_ib_b += Eigen::Vector3d(400.0, 0.0, 0.0);  // 2 s of an impossible 40 g push: > 100 m/s within 0.3 s
+    ++hit;
+  }
+  ASSERT_GT(hit, 150);
+  fusion::EngineOptions o = w.options;
+  o.smoother_enabled = true;
+  auto r = run(w, in, o);
+  ASSERT_TRUE(r) << r.error().message;
+  const auto& s = r->summary;
+  const Errors e = errors(w, *r, t0.plus_s(2.0 + kRecoveryTime_s));
+  std::string events;
+  for (const auto& ev : s.health_events) events += ev + "\n";
+  std::printf("[ robust ] IMU garbage: %d re-initializations, max error from 60 s after: %.2f m\n%s",
+              s.reinitializations, e.max_from, events.c_str());
+  EXPECT_FALSE(s.covariance_healthy);
+  EXPECT_GE(s.reinitializations, 1);
+  EXPECT_THAT(events, HasSubstr("filter diverged at"));
+  EXPECT_THAT(events, HasSubstr("re-initialized at"));
+  EXPECT_THAT(s.smoother_message, HasSubstr("not smoothed: the filter was re-initialized"));
+  EXPECT_TRUE(r->smoothed.empty());
+  EXPECT_LT(e.max_from, kMaxErrorAfterRecovery_m);
+  EXPECT_GT(count_of(s.imu_skipped, "filter_diverged"), 0);
+  expect_accounting(in, s);
+}
+
+// Divergence with a plausible state and a healthy-looking covariance: the filter starts 300 m off with a 5 cm σ (a
+// wrong configured position it trusts), so it rejects most code measurements epoch after epoch. The innovation
+// watch calls that divergence and re-initializes from the GNSS epoch solution.
+TEST(RobustHealth, ConfidentWrongPositionIsCaughtByImplausibleInnovationsAndReinitialized) {
+  Walk& w = short_walk();
+  const Inputs in = inputs_of(w);
+  fusion::EngineOptions o = w.options;
+  const Vector3d p0 = w.sim.truth.nav.front().p_eb_e;
+  o.initial_position_e = p0 + R_e_n(geodetic_from_ecef(p0).lat, geodetic_from_ecef(p0).lon) * Vector3d(0, kWrongStart_m, 0);
+  o.initial_sigma_pos_m = kConfidentSigma_m;
+  auto r = run(w, in, o);
+  ASSERT_TRUE(r) << r.error().message;
+  const auto& s = r->summary;
+  std::string events;
+  for (const auto& ev : s.health_events) events += ev + "\n";
+  const auto reinit = events.find("re-initialized at ");
+  ASSERT_NE(reinit, std::string::npos) << events;
+  // The first re-initialization time, from the event text ("re-initialized at 2024-02-11 15:06:40.000 GPST").
+  CalendarTime c;
+  ASSERT_EQ(std::sscanf(events.c_str() + reinit, "re-initialized at %d-%d-%d %d:%d:%lf", &c.year, &c.month, &c.day,
+                        &c.hour, &c.minute, &c.second),
+            6)
+      << events;
+  const GpsTime t_first = GpsTime::from_calendar_gpst(c);
+  const Errors e = errors(w, *r, t_first.plus_s(kRecoveryTime_s));
+  std::printf("[ robust ] start 300 m off with sigma 5 cm: %d re-initializations, max error from 60 s after the first: "
+              "%.2f m\n%s",
+              s.reinitializations, e.max_from, events.c_str());
+  EXPECT_FALSE(s.covariance_healthy);
+  EXPECT_THAT(events, HasSubstr("innovations implausible"));
+  EXPECT_GE(s.reinitializations, 1);
+  EXPECT_LT(e.max_from, kMaxErrorAfterRecovery_m);
+  expect_accounting(in, s);
+}
+
+TEST(RobustHealth, InsModeDivergenceStillFailsWithAClearMessage) {
+  Walk& w = short_walk();
+  Inputs in = inputs_of(w);
+  const GpsTime t0 = mid_time(w);
+  for (auto& s : in.imu)
+    if (s.t >= t0 && s.t - t0 <= 2.0) s.f_ib_b += Eigen::Vector3d(400.0, 0.0, 0.0);
+  fusion::EngineOptions o = w.options;
+  o.mode = fusion::Mode::kInsOnly;
+  o.initial_position_e = w.sim.truth.nav.front().p_eb_e;
+  o.initial_yaw_rad = 0.0;
+  auto r = run(w, in, o);
+  ASSERT_FALSE(r);
+  EXPECT_THAT(r.error().message, HasSubstr("filter diverged at"));
+}
+
+TEST(RobustImuFault, NonFiniteSamplesGivenToTheEngineAreRejectedAndCounted) {
+  Walk& w = short_walk();
+  Inputs in = inputs_of(w);
+  const size_t mid = in.imu.size() / 2;
+  in.imu[mid].omega_ib_b.x() = std::numeric_limits<double>::quiet_NaN();
+  in.imu[mid + 7].f_ib_b.z() = std::numeric_limits<double>::infinity();
+  auto r = run(w, in, w.options);
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(count_of(r->summary.imu_rejected, "non_finite"), 2);
+  EXPECT_TRUE(r->summary.covariance_healthy) << r->summary.health_message;
+  expect_accounting(in, r->summary);
+}
+
+TEST(RobustGnssFault, TenMinutesWithoutSatellitesBridgedByInsAndRecovered) {
+  static Walk w = make_walk(5);
+  Inputs in = inputs_of(w);
+  const GpsTime t0 = in.rover.front().time.plus_s(90.0);
+  const GpsTime t1 = t0.plus_s(kOutage_s);
+  ASSERT_LT(t1, in.rover.back().time.plus_s(-kRecoveryTime_s - 30.0)) << "the walk is too short for the outage";
+  std::erase_if(in.rover, [&](const gnss::ObsEpoch& e) { return e.time >= t0 && e.time < t1; });
+  auto r = run(w, in, w.options);
+  ASSERT_TRUE(r) << r.error().message;
+  const Errors e = errors(w, *r, t1.plus_s(kRecoveryTime_s));
+  // The largest error and the largest sigma during the outage.
+  const Errors after_outage_start = errors(w, *r, t0);
+  double sd_max = 0;
+  for (const auto& out : r->epochs)
+    if (out.t >= t0 && out.t < t1) sd_max = std::max(sd_max, std::sqrt(out.cov_p_n(0, 0) + out.cov_p_n(1, 1)));
+  std::printf("[ robust ] 10 min without satellites: max error from the outage on %.1f m (horizontal sigma up to "
+              "%.1f m), max from 60 s after %.2f m, %d re-initializations\n",
+              after_outage_start.max_from, sd_max, e.max_from, r->summary.reinitializations);
+  for (size_t k = 1; k < r->epochs.size(); ++k) ASSERT_LE(r->epochs[k].t - r->epochs[k - 1].t, kMaxOutputGap_s);
+  EXPECT_LT(e.max_from, kMaxErrorAfterRecovery_m);
+  EXPECT_GT(sd_max, 1.0);  // the filter knows it is coasting
+  expect_accounting(in, r->summary);
+}
+
+}  // namespace
+}  // namespace pednav
