@@ -266,7 +266,8 @@ class Filter {
   /// End the current run without computing its map (before the first output epoch nothing is stored).
   void drop_smoother_step() { run_open_ = false; }
 
-  bool healthy(std::string& why) const {
+  // check_covariance: also the symmetry / positive semi-definiteness test (an LDLT: done at the output epochs only).
+  bool healthy(std::string& why, bool check_covariance) const {
     if (!P_.allFinite() || !x_.nav.p_eb_e.allFinite() || !x_.nav.v_eb_e.allFinite()) {
       why = "non-finite state or covariance";
       return false;
@@ -277,7 +278,7 @@ class Filter {
         return false;
       }
     }
-    if (const char* defect = covariance_defect(P_)) {
+    if (const char* defect = check_covariance ? covariance_defect(P_) : nullptr) {
       why = defect;
       return false;
     }
@@ -480,7 +481,8 @@ class Runner {
       }
       prev_stance = stance;
       std::string why;
-      if (!f.healthy(why) || implausible_streak_ >= kImplausibleEpochs) {
+      const bool output_now = inc.t1.ns() >= next_out_ns;
+      if (!f.healthy(why, output_now) || implausible_streak_ >= kImplausibleEpochs) {
         if (why.empty()) {
           why = "innovations implausible: " + std::to_string(implausible_streak_) +
                 " consecutive GNSS epochs with most code measurements rejected";
@@ -499,7 +501,6 @@ class Runner {
         return;
       }
       if (stance) last_stance = f.x();
-      const bool output_now = inc.t1.ns() >= next_out_ns;
       // Smoother: close the run of steps at an update or an output epoch (eq. 12.13), else compose on.
       if (smooth && !reinitialized_at && (f.step_updated() || output_now)) {
         if (segment_open) {
