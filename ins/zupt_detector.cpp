@@ -112,15 +112,79 @@ HmmDetection detect_gait_hmm(const std::vector<ImuSample>& s, const ZuptDetector
   }
   const HmmModel decode_model = floored(h.model, o.hmm_decode_floor);
   h.obs_states = o.hmm_decoder == "forward" ? forward_decode(decode_model, symbols) : viterbi(decode_model, symbols);
-  const std::vector<int> per_sample =
-      states_per_sample(h.observations, h.obs_states, stance_grades(h.model, o.hmm_stance_grade_probability));
+  const std::array<bool, kHmmSymbols> still = stance_grades(h.model, o.hmm_stance_grade_probability);
+  const std::vector<int> per_sample = states_per_sample(h.observations, h.obs_states, still);
   for (std::size_t k = 0; k < s.size(); ++k) {
     h.decisions[k].statistic = h.observations.rate_radps[k];
     h.decisions[k].gait_state = per_sample[k];
-    h.decisions[k].stance = per_sample[k] == kStance;
+    // Stance = state D AND a stance grade: a D decoded on an extreme far from zero rate (e.g. grade 13 at the
+    // first, half step of the x-io long walk, b_D = 0.026) would otherwise put its whole swing dwell into stance.
+    h.decisions[k].stance = per_sample[k] == kStance && still[static_cast<std::size_t>(h.observations.grade[k])];
+  }
+  // A long rest (smoothed rate within one grade of zero for >= hmm_rest_s) is stance whatever was decoded: the
+  // trained cycle has no D -> D transition, and a rest is one merged observation (e.g. the final 14 s of the x-io
+  // long walk, decoded as push-off after a short last step).
+  if (o.hmm_rest_s > 0) {
+    const auto& g = h.observations.grade;
+    for (std::size_t k = 0; k < g.size();) {
+      if (g[k] != 7 && g[k] != 8) {
+        ++k;
+        continue;
+      }
+      std::size_t j = k;
+      while (j + 1 < g.size() && (g[j + 1] == 7 || g[j + 1] == 8)) ++j;
+      if (s[j].t - s[k].t >= o.hmm_rest_s) {
+        for (std::size_t i = k; i <= j; ++i) h.decisions[i].stance = true;
+      }
+      k = j + 1;
+    }
+  }
+  // Stance shortening with a gait-speed adaptive threshold: keep the contiguous core of each stance interval
+  // where the SHOE statistic is below max(γ, factor · its minimum in the interval).
+  if (o.hmm_refine_factor > 0) {
+    const std::vector<double> t = shoe_statistic(s, o);
+    for (std::size_t i = 0; i < s.size();) {
+      if (!h.decisions[i].stance) {
+        ++i;
+        continue;
+      }
+      std::size_t j = i;
+      while (j + 1 < s.size() && h.decisions[j + 1].stance) ++j;
+      std::size_t m = i;
+      for (std::size_t k = i; k <= j; ++k) {
+        if (t[k] < t[m]) m = k;
+      }
+      const double thr = std::max(o.shoe_threshold, o.hmm_refine_factor * t[m]);
+      std::size_t a = m, b = m;
+      while (a > i && t[a - 1] < thr) --a;
+      while (b < j && t[b + 1] < thr) ++b;
+
+      for (std::size_t k = i; k <= j; ++k) h.decisions[k].stance = k >= a && k <= b;
+      i = j + 1;
+    }
   }
   drop_short_runs(h.decisions, s, o.min_stance_s);
   return h;
+}
+
+std::vector<double> shoe_statistic(const std::vector<ImuSample>& s, const ZuptDetectorOptions& o) {
+  const int n = static_cast<int>(s.size());
+  std::vector<double> out(s.size(), 0.0);
+  const int h = half_window(s, o.shoe_window_s);
+  const double ia = 1.0 / (o.shoe_sigma_accel_mps2 * o.shoe_sigma_accel_mps2);
+  const double ig = 1.0 / (o.shoe_sigma_gyro_radps * o.shoe_sigma_gyro_radps);
+  for (int k = 0; k < n; ++k) {
+    const int a = std::max(0, k - h), b = std::min(n - 1, k + h);
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int j = a; j <= b; ++j) mean += s[j].f_ib_b;
+    mean /= static_cast<double>(b - a + 1);
+    const Eigen::Vector3d g_dir =
+        mean.norm() > 0 ? Eigen::Vector3d(mean.normalized() * kGravityNominal_mps2) : Eigen::Vector3d::Zero();
+    double t = 0.0;
+    for (int j = a; j <= b; ++j) t += ia * (s[j].f_ib_b - g_dir).squaredNorm() + ig * s[j].omega_ib_b.squaredNorm();
+    out[k] = t / static_cast<double>(b - a + 1);
+  }
+  return out;
 }
 
 std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& s, const ZuptDetectorOptions& o) {
@@ -149,19 +213,10 @@ std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& s, const Z
       d[k].stance = d[k].statistic < (are ? o.are_threshold : o.mag_threshold);
     }
   } else if (o.detector == "shoe") {
-    const int h = half_window(s, o.shoe_window_s);
-    const double ia = 1.0 / (o.shoe_sigma_accel_mps2 * o.shoe_sigma_accel_mps2);
-    const double ig = 1.0 / (o.shoe_sigma_gyro_radps * o.shoe_sigma_gyro_radps);
+    const std::vector<double> t = shoe_statistic(s, o);
     for (int k = 0; k < n; ++k) {
-      const int a = std::max(0, k - h), b = std::min(n - 1, k + h);
-      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-      for (int j = a; j <= b; ++j) mean += s[j].f_ib_b;
-      mean /= static_cast<double>(b - a + 1);
-      const Eigen::Vector3d g_dir = mean.norm() > 0 ? Eigen::Vector3d(mean.normalized() * kGravityNominal_mps2) : Eigen::Vector3d::Zero();
-      double t = 0.0;
-      for (int j = a; j <= b; ++j) t += ia * (s[j].f_ib_b - g_dir).squaredNorm() + ig * s[j].omega_ib_b.squaredNorm();
-      d[k].statistic = t / static_cast<double>(b - a + 1);
-      d[k].stance = d[k].statistic < o.shoe_threshold;
+      d[k].statistic = t[k];
+      d[k].stance = t[k] < o.shoe_threshold;
     }
   } else {
     // seed 004 eq. 1: sigma_{k} = std of |f| over the window; stance if sigma < threshold and t_k - t_s > Δt,

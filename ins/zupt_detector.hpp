@@ -42,6 +42,14 @@ struct ZuptDetectorOptions {
   /// A stance dwell extends over samples in any grade the (trained) stance state emits with at least this
   /// probability (docs/zupt.md §3); > 1 keeps stance to its observation's own grade.
   double hmm_stance_grade_probability = 0.05;
+  /// HMM: a run of at least this many seconds with the smoothed rate in the two grades at zero rate (|r| < w) is
+  /// stance whatever state was decoded (docs/zupt.md §3: a long rest is one merged observation that the trained
+  /// cycle, which has no D -> D transition, may decode as push-off). <= 0: off.
+  double hmm_rest_s = 0.5;
+  /// HMM: stance shortening by the SHOE statistic T (same window, sigmas and γ as `shoe`), a threshold that adapts
+  /// to gait speed: in each decoded stance interval only the contiguous run around the minimum T_min of T with
+  /// T < max(γ, factor · T_min) is kept (docs/zupt.md §3). <= 0: off (the whole decoded stance).
+  double hmm_refine_factor = 0.0;
   double min_stance_s = 0.04;       ///< shorter stance runs are discarded [s]
   /// Every problem at once, empty when valid ("zupt.mv_threshold_mps2 must be > 0").
   std::vector<std::string> problems() const;
@@ -67,6 +75,10 @@ struct HmmDetection {
 /// HMM detector of seed 002 over time-ordered samples (GPST): extraction, optional Baum-Welch on the log,
 /// decoding, mapping to samples (states_per_sample), stance = state D, short runs dropped.
 HmmDetection detect_gait_hmm(const std::vector<ImuSample>& samples, const ZuptDetectorOptions& options);
+
+/// SHOE / GLRT statistic (Skog et al. 2010 eq. 7) per sample over time-ordered samples, window W = shoe_window_s
+/// centred on the sample, sigmas shoe_sigma_*; dimensionless.
+std::vector<double> shoe_statistic(const std::vector<ImuSample>& samples, const ZuptDetectorOptions& options);
 
 /// Run the configured detector over time-ordered samples (GPST). Returns one decision per sample.
 std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& samples, const ZuptDetectorOptions& options);

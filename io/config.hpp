@@ -82,6 +82,8 @@ struct ZuptConfig {
   bool hmm_auto_sign = true;              ///< try both signs of hmm_gyro_axis, keep the likelier (docs/zupt.md)
   int hmm_max_iterations = 200;
   std::string hmm_decoder = "viterbi";    ///< viterbi | forward
+  double hmm_rest_s = 0.5;                ///< rest of at least this long is stance (ins::ZuptDetectorOptions)
+  double hmm_refine_factor = 0.0;         ///< stance shortening by SHOE, adaptive threshold (0: off)
   double sigma_mps = 0.02;                ///< ZUPT measurement noise per axis
   bool zaru = true;
   double zaru_sigma_radps = 0.01;         ///< key zaru_sigma_deg_per_s

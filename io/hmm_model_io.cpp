@@ -167,6 +167,8 @@ void read_zupt_hmm_keys(YamlMap& z, ZuptConfig& c) {
   z.boolean("hmm_auto_sign", c.hmm_auto_sign);
   z.integer("hmm_max_iterations", c.hmm_max_iterations, false, 0, 100000);
   z.choice("hmm_decoder", c.hmm_decoder, {"viterbi", "forward"});
+  z.number("hmm_rest_s", c.hmm_rest_s, false, 0.0, 60.0);
+  z.number("hmm_refine_factor", c.hmm_refine_factor, false, 0.0, 1e6);
   z.path("hmm_model", c.hmm_model_file);
   if (!c.hmm_model_file.empty()) {
     auto m = read_hmm_model(c.hmm_model_file);
@@ -216,6 +218,8 @@ ins::ZuptDetectorOptions zupt_detector_options(const ZuptConfig& c) {
   o.hmm_auto_sign = c.hmm_auto_sign;
   o.hmm_max_iterations = c.hmm_max_iterations;
   o.hmm_decoder = c.hmm_decoder;
+  o.hmm_rest_s = c.hmm_rest_s;
+  o.hmm_refine_factor = c.hmm_refine_factor;
   return o;
 }
 

@@ -144,5 +144,93 @@ TEST(ZuptDetector, HmmFindsEveryStanceOfASyntheticWalk) {
   EXPECT_EQ(runs_f, g.stances);
 }
 
+
+// Gait whose stance rolls (heel roll +0.7 rad/s for 0.1 s, flat foot at `flat_radps` for 0.25 s, toe roll
+// -0.5 rad/s for 0.1 s, both rolls on top of `flat_radps`) before push-off -6, swing +7, heel strike -3 rad/s; `stance` = the flat-foot samples.
+// Outside the flat foot the specific force also vibrates (8 m/s^2 at 40 Hz, SHOE T about 130), so the SHOE statistic is not small
+// where the rate crosses zero between phases.
+Gait rolling_walk(int cycles, double flat_radps) {
+  struct Phase {
+    double dur_s, amp_radps;
+    bool flat, roll;
+  };
+  const Phase phases[] = {{0.1, 0.7, false, true},    {0.25, 0.0, true, false},  {0.1, -0.5, false, true},
+                          {0.15, -6.0, false, false}, {0.35, 7.0, false, false}, {0.1, -3.0, false, false}};
+  Gait g;
+  double t = 0.0;
+  unsigned lcg = 777;
+  auto noise = [&] {
+    lcg = lcg * 1103515245u + 12345u;
+    return 0.03 * (static_cast<double>((lcg >> 8) & 0xffff) / 65535.0 - 0.5);
+  };
+  for (int c = 0; c < cycles; ++c) {
+    ++g.stances;
+    for (const Phase& p : phases) {
+      const int n = static_cast<int>(std::lround(p.dur_s * kRate_hz));
+      for (int k = 0; k < n; ++k) {
+        ImuSample x;
+        x.t = GpsTime::from_week_tow(0, t);
+        const double roll = p.roll ? flat_radps : 0.0;  // the rolls turn on top of the flat-foot rate
+        x.omega_ib_b.y() = (p.flat ? flat_radps : roll + p.amp_radps * std::sin(kPi * (k + 0.5) / n)) + noise();
+        x.f_ib_b = Eigen::Vector3d(p.flat ? 0.0 : 8.0 * std::sin(2 * kPi * 40 * t), 0, -9.80665);
+        g.samples.push_back(x);
+        g.stance.push_back(p.flat);
+        t += 1.0 / kRate_hz;
+      }
+    }
+  }
+  return g;
+}
+
+struct StanceCount {
+  int runs = 0;        // stance intervals
+  int rolling = 0;     // stance samples outside the flat-foot phase
+  int flat_missed = 0; // flat-foot samples not stance
+};
+
+StanceCount count(const Gait& g, const std::vector<ZuptDecision>& d) {
+  StanceCount c;
+  for (std::size_t k = 0; k < d.size(); ++k) {
+    c.runs += d[k].stance && (k == 0 || !d[k - 1].stance);
+    c.rolling += d[k].stance && !g.stance[k];
+    c.flat_missed += !d[k].stance && g.stance[k];
+  }
+  return c;
+}
+
+TEST(ZuptDetector, HmmRefineKeepsTheQuietCoreOfEachStance) {
+  const Gait g = rolling_walk(12, 0.0);
+  ZuptDetectorOptions o;
+  o.detector = "hmm";
+  const StanceCount whole = count(g, detect_stance(g.samples, o));
+  // Without refinement the decoded stance takes in the heel and toe rolls (|rate| < one grade, 1.05 rad/s).
+  constexpr int kMinRollingSamples = 12 * 20;  // at least 0.1 s of roll per step
+  EXPECT_GT(whole.rolling, kMinRollingSamples);
+  o.hmm_refine_factor = 2.0;
+  const StanceCount core = count(g, detect_stance(g.samples, o));
+  EXPECT_EQ(core.runs, g.stances);  // still one stance per step
+  // The core is the flat foot (SHOE T < γ = 10 with σω 0.1 rad/s: |rate| < 0.32 rad/s) and a few roll samples
+  // where the 0.03 s SHOE window still averages in the flat part.
+  constexpr int kMaxRollingPerStep = 8;
+  EXPECT_LE(core.rolling, kMaxRollingPerStep * g.stances);
+  // It loses at most the SHOE half window (3 samples) plus one at each end of the flat foot.
+  constexpr int kMaxFlatMissedPerStep = 8;
+  EXPECT_LE(core.flat_missed, kMaxFlatMissedPerStep * g.stances);
+}
+
+TEST(ZuptDetector, HmmRefineThresholdAdaptsToAFootThatNeverStops) {
+  // Fast gait: the flat foot still turns at 0.6 rad/s (SHOE T about 36 > γ = 10 everywhere in stance). A fixed
+  // threshold finds no stance; the refined HMM keeps one core per step around the minimum (threshold 2 T_min).
+  const Gait g = rolling_walk(12, 0.6);
+  ZuptDetectorOptions o;
+  o.detector = "shoe";
+  EXPECT_EQ(count(g, detect_stance(g.samples, o)).runs, 0);
+  o.detector = "hmm";
+  o.hmm_refine_factor = 2.0;
+  const StanceCount c = count(g, detect_stance(g.samples, o));
+  EXPECT_EQ(c.runs, g.stances);
+  EXPECT_LE(c.rolling, 8 * g.stances);
+}
+
 }  // namespace
 }  // namespace pednav::ins
