@@ -158,7 +158,14 @@ HmmDetection detect_gait_hmm(const std::vector<ImuSample>& s, const ZuptDetector
       std::size_t a = m, b = m;
       while (a > i && t[a - 1] < thr) --a;
       while (b < j && t[b + 1] < thr) ++b;
-
+      // Refinement never removes a step: the core is widened (towards the smaller T) to min_stance_s.
+      while (s[b].t - s[a].t < o.min_stance_s && (a > i || b < j)) {
+        if (b >= j || (a > i && t[a - 1] < t[b + 1])) {
+          --a;
+        } else {
+          ++b;
+        }
+      }
       for (std::size_t k = i; k <= j; ++k) h.decisions[k].stance = k >= a && k <= b;
       i = j + 1;
     }

@@ -48,7 +48,7 @@ struct ZuptDetectorOptions {
   double hmm_rest_s = 0.5;
   /// HMM: stance shortening by the SHOE statistic T (same window, sigmas and γ as `shoe`), a threshold that adapts
   /// to gait speed: in each decoded stance interval only the contiguous run around the minimum T_min of T with
-  /// T < max(γ, factor · T_min) is kept (docs/zupt.md §3). <= 0: off (the whole decoded stance).
+  /// T < max(γ, factor · T_min) is kept, widened to min_stance_s (docs/zupt.md §3). <= 0: off.
   double hmm_refine_factor = 0.0;
   double min_stance_s = 0.04;       ///< shorter stance runs are discarded [s]
   /// Every problem at once, empty when valid ("zupt.mv_threshold_mps2 must be > 0").
