@@ -133,7 +133,8 @@ class Filter {
   // Mechanize one (already bias-corrected) increment and propagate the covariance.
   void predict(const ins::ImuIncrement& inc) {
     const ins::NavState after = ins::mechanize(x_.nav, inc);
-    ins::DiscreteErrorModel m = ins::interval_error_model(layout_, o_.spec, x_.nav, after, inc);
+    ins::DiscreteErrorModel& m = model_;
+    ins::interval_error_model(layout_, o_.spec, x_.nav, after, inc, m);
     const double dt = inc.dt_s;
     if (o_.mode == Mode::kTightlyCoupled) {
       const int d = drift_block_.offset;
@@ -154,12 +155,14 @@ class Filter {
       // eq. 12.13): keep the posterior at the run's start and compose Φ.
       if (!run_open_) {
         P_post_prev_ = P_;
-        Phi_ = m.Phi;
+        PhiT_ = m.Phi.transpose();
         run_open_ = true;
         run_steps_ = 1;
       } else {
-        Phi_sparse_.times(Phi_, tmp_);
-        Phi_ = tmp_;
+        // Φ_run ← Φ Φ_run, kept transposed so that the product is a sum of columns: Φ_runᵀ ← Φ_runᵀ Φᵀ.
+        tmp_.setZero(PhiT_.rows(), PhiT_.cols());
+        Phi_sparse_.add_times_transposed(PhiT_, tmp_);
+        PhiT_ = tmp_;
         ++run_steps_;
       }
     }
@@ -238,7 +241,7 @@ class Filter {
   // transition of this step (row i of Φ zero, prior variance var, corrections to i before the reset void; eq. 12.11).
   void fold_reset_into_prior(int i, double var) {
     if (!recording_) return;
-    Phi_.row(i).setZero();
+    PhiT_.col(i).setZero();
     P_prior_.row(i).setZero();
     P_prior_.col(i).setZero();
     P_prior_(i, i) = var;
@@ -255,10 +258,10 @@ class Filter {
   /// Backward map of the run of steps that just ended (call after all updates of its last step); the next
   /// predict() starts a new run.
   void smoother_step(RtsStep& out) {
-    if (run_steps_ != 1) PhiP_.noalias() = Phi_ * P_post_prev_;
+    if (run_steps_ != 1) PhiP_.noalias() = PhiT_.transpose() * P_post_prev_;
     // A reset folded into Φ (eq. 12.11) zeroes rows of Φ after Φ P was kept: recompute it then.
-    if (reset_in_step_) PhiP_.noalias() = Phi_ * P_post_prev_;
-    rts_step(P_post_prev_, Phi_, P_prior_, A_, d_, PhiP_, out);
+    if (reset_in_step_) PhiP_.noalias() = PhiT_.transpose() * P_post_prev_;
+    rts_step(P_post_prev_, PhiT_.transpose(), P_prior_, A_, d_, PhiP_, out);
     run_open_ = false;
   }
   /// Whether steps have been predicted since the last closed run.
@@ -311,6 +314,7 @@ class Filter {
   std::vector<ins::Block> clock_blocks_;
   ins::Block drift_block_{0, 0};
   ins::InsState x_;
+  ins::DiscreteErrorModel model_;  // Φ, Q_d of the current step (reused: no per-step construction)
   ErrorMatrix P_;
   ErrorMatrix tmp_;
   std::vector<double> clock_m_;
@@ -323,7 +327,7 @@ class Filter {
   bool reset_in_step_ = false;
   int run_steps_ = 0;
   ColumnSparse<ins::kMaxErrorDim> Phi_sparse_;
-  ErrorMatrix P_post_prev_, Phi_, P_prior_, A_, PhiP_;
+  ErrorMatrix P_post_prev_, PhiT_, P_prior_, A_, PhiP_;  // PhiT_: the run's Φ, transposed
   ErrorVector d_;
 };
 

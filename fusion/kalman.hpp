@@ -21,12 +21,17 @@ inline void covariance_predict(ins::ErrorMatrix& P, const ins::ErrorMatrix& Phi,
   P = 0.5 * (P + P.transpose()).eval();
 }
 
-/// The same with Φ given by its nonzeros (Φ of the INS error model is about half zeros): P ← Φ P Φᵀ + Q_d.
+/// The same with Φ given by its nonzeros (Φ of the INS error model is mostly zeros): P ← Φ P Φᵀ + Q_d; on return
+/// tmp = Φ P (the prior P). Both products are sums of whole columns (contiguous, vectorized): P Φᵀ column by column,
+/// then Φ P = (P Φᵀ)ᵀ as P is symmetric, and Φ P Φᵀ = (Φ P) Φᵀ the same way (docs/performance.md §1).
 inline void covariance_predict(ins::ErrorMatrix& P, const ColumnSparse<ins::kMaxErrorDim>& Phi,
                                const ins::ErrorMatrix& Qd, ins::ErrorMatrix& tmp) {
-  Phi.times(P, tmp);
+  ins::ErrorMatrix PPhit;
+  PPhit.setZero(P.rows(), P.cols());
+  Phi.add_times_transposed(P, PPhit);  // P Φᵀ
+  tmp = PPhit.transpose();             // Φ P
   P = Qd;
-  Phi.add_times_transposed(tmp, P);
+  Phi.add_times_transposed(tmp, P);  // Q_d + Φ P Φᵀ
   P = 0.5 * (P + P.transpose()).eval();
 }
 

@@ -2,6 +2,7 @@
 // δb_a [12,15), then registered optional blocks. Noise order: n_g, n_a, w_bg, w_ba, (w_sg), (w_sa).
 #include "ins/error_state.hpp"
 
+#include <array>
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "core/column_sparse.hpp"
@@ -168,8 +169,138 @@ DiscreteErrorModel discretize(const ContinuousErrorModel& model, double dt_s, Qd
   return d;
 }
 
+namespace {
+
+// The INS error model of eq. (3.1)-(3.8) as a matrix of 3x3 blocks (at most 7 x 7: pos, vel, att, gyro bias,
+// accel bias, gyro scale, accel scale) with a flag per nonzero block: Φ and Q_d of the series method are
+// products of a few 3x3 blocks (docs/error_state.md §5, docs/performance.md §1), not of n x n matrices.
+constexpr int kMaxInsBlocks = 7;
+struct Blocks3 {
+  std::array<int, kMaxInsBlocks> offset{};
+  int count = 0;
+  std::array<std::array<Eigen::Matrix3d, kMaxInsBlocks>, kMaxInsBlocks> m;
+  std::array<std::array<bool, kMaxInsBlocks>, kMaxInsBlocks> nz{};
+  void set(int i, int j, const Eigen::Matrix3d& v) {
+    m[i][j] = v;
+    nz[i][j] = true;
+  }
+};
+
+// Φ = I + FΔt + (FΔt)²/2 and Q_d = SΔt + (FS + SFᵀ)Δt²/2 + FSFᵀΔt³/3 (S = G Q Gᵀ, block-diagonal) from the
+// blocks of F and S; written into the n x n matrices of d (other states: identity transition, no noise). Every
+// noise of eq. (3.1)-(3.8) is isotropic, so each diagonal block of S is a multiple of I (S_vv = R σ² I Rᵀ = σ² I):
+// s[k] holds it.
+void discretize_blocks(const Blocks3& F, const std::array<double, kMaxInsBlocks>& s, int n, double dt,
+                       DiscreteErrorModel& d) {
+  const int nb = F.count;
+  const double h2 = 0.5 * dt * dt, h3 = dt * dt * dt / 3.0;
+  d.Phi.setIdentity(n, n);
+  d.Qd.setZero(n, n);
+  for (int i = 0; i < nb; ++i) {
+    const int ri = F.offset[i];
+    for (int j = 0; j < nb; ++j) {
+      // Φ_ij = F_ij Δt + Σ_k F_ik F_kj Δt²/2 (+ I on the diagonal, already set).
+      bool any = F.nz[i][j];
+      Eigen::Matrix3d phi = any ? Eigen::Matrix3d(F.m[i][j] * dt) : Eigen::Matrix3d::Zero();
+      for (int k = 0; k < nb; ++k) {
+        if (F.nz[i][k] && F.nz[k][j]) {
+          phi.noalias() += (F.m[i][k] * F.m[k][j]) * h2;
+          any = true;
+        }
+      }
+      if (any) d.Phi.block<3, 3>(ri, F.offset[j]) += phi;
+      if (j < i) continue;  // Q_d is symmetric: the upper blocks, mirrored
+      // Q_d,ij = S_ij Δt + (F_ij S_jj + S_ii F_jiᵀ) Δt²/2 + Σ_k F_ik S_kk F_jkᵀ Δt³/3.
+      Eigen::Matrix3d q = Eigen::Matrix3d::Zero();
+      any = false;
+      if (i == j && s[i] != 0.0) {
+        q.diagonal().setConstant(s[i] * dt);
+        any = true;
+      }
+      if (F.nz[i][j] && s[j] != 0.0) {
+        q += (s[j] * h2) * F.m[i][j];
+        any = true;
+      }
+      if (F.nz[j][i] && s[i] != 0.0) {
+        q += (s[i] * h2) * F.m[j][i].transpose();
+        any = true;
+      }
+      for (int k = 0; k < nb; ++k) {
+        if (F.nz[i][k] && F.nz[j][k] && s[k] != 0.0) {
+          q.noalias() += (s[k] * h3) * (F.m[i][k] * F.m[j][k].transpose());
+          any = true;
+        }
+      }
+      if (!any) continue;
+      if (i == j) {
+        d.Qd.block<3, 3>(ri, ri) = 0.5 * (q + q.transpose());
+      } else {
+        d.Qd.block<3, 3>(ri, F.offset[j]) = q;
+        d.Qd.block<3, 3>(F.offset[j], ri) = q.transpose();
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void interval_error_model(const ErrorStateLayout& layout, const ImuSpec& spec, const NavState& before,
+                          const NavState& after, const ImuIncrement& inc, DiscreteErrorModel& out) {
+  const double dt = inc.dt_s;
+  const Eigen::Matrix3d R = before.q_e_b.slerp(0.5, after.q_e_b).toRotationMatrix();
+  const Eigen::Vector3d p_mid = 0.5 * (before.p_eb_e + after.p_eb_e);
+  const Eigen::Vector3d f_e = specific_force_increment_e(before, inc) / dt;
+  const Eigen::Vector3d f_b = R.transpose() * f_e;
+  const Eigen::Vector3d omega_b = inc.alpha_b / dt;
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d W = skew(kOmegaIE_e);
+  auto psd_gm = [](double sigma, double tau) { return tau > 0.0 ? 2.0 * sigma * sigma / tau : 0.0; };
+
+  // Blocks of F (eq. 3.1-3.8; the same entries as continuous_error_model) and of S = G Q Gᵀ (block-diagonal:
+  // every noise drives one block).
+  enum { P, V, A, BG, BA };
+  Blocks3 F;
+  std::array<double, kMaxInsBlocks> S{};  // S_kk = S[k] I
+  F.count = 5;
+  F.offset = {kPos.offset, kVel.offset, kAtt.offset, kBiasGyro.offset, kBiasAcc.offset, 0, 0};
+  F.set(P, V, I);
+  F.set(V, P, gravity_gradient_ecef(p_mid));
+  F.set(V, V, -2.0 * W);
+  F.set(V, A, -skew(f_e));
+  F.set(V, BA, -R);
+  F.set(A, A, -W);
+  F.set(A, BG, -R);
+  if (spec.gyro_bias_tau_s > 0.0) F.set(BG, BG, -I / spec.gyro_bias_tau_s);
+  if (spec.accel_bias_tau_s > 0.0) F.set(BA, BA, -I / spec.accel_bias_tau_s);
+  S[P] = 0.0;
+  S[V] = spec.accel_vrw * spec.accel_vrw;  // R (σ² I) Rᵀ
+  S[A] = spec.gyro_arw * spec.gyro_arw;
+  S[BG] = psd_gm(spec.gyro_bias_instability, spec.gyro_bias_tau_s) + spec.gyro_bias_rw * spec.gyro_bias_rw;
+  S[BA] = psd_gm(spec.accel_bias_instability, spec.accel_bias_tau_s) + spec.accel_bias_rw * spec.accel_bias_rw;
+  if (const auto sg = layout.find(kScaleGyroBlock)) {
+    const int s = F.count++;
+    F.offset[s] = sg->offset;
+    F.set(A, s, -R * omega_b.asDiagonal());
+    if (spec.scale_tau_s > 0.0) F.set(s, s, -I / spec.scale_tau_s);
+    S[s] = psd_gm(spec.gyro_scale_sigma, spec.scale_tau_s);
+  }
+  if (const auto sa = layout.find(kScaleAccBlock)) {
+    const int s = F.count++;
+    F.offset[s] = sa->offset;
+    F.set(V, s, -R * f_b.asDiagonal());
+    if (spec.scale_tau_s > 0.0) F.set(s, s, -I / spec.scale_tau_s);
+    S[s] = psd_gm(spec.accel_scale_sigma, spec.scale_tau_s);
+  }
+  discretize_blocks(F, S, layout.dim(), dt, out);
+}
+
 DiscreteErrorModel interval_error_model(const ErrorStateLayout& layout, const ImuSpec& spec, const NavState& before,
                                         const NavState& after, const ImuIncrement& inc, QdMethod method) {
+  if (method == QdMethod::kSeries) {
+    DiscreteErrorModel d;
+    interval_error_model(layout, spec, before, after, inc, d);
+    return d;
+  }
   const double dt = inc.dt_s;
   const Eigen::Matrix3d R_mid = before.q_e_b.slerp(0.5, after.q_e_b).toRotationMatrix();
   const Eigen::Vector3d p_mid = 0.5 * (before.p_eb_e + after.p_eb_e);

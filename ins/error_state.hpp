@@ -104,6 +104,13 @@ DiscreteErrorModel interval_error_model(const ErrorStateLayout& layout, const Im
                                         const NavState& after, const ImuIncrement& inc,
                                         QdMethod method = QdMethod::kSeries);
 
+/// The same model (series Q_d) written into `out` (n x n, n = layout.dim(); states outside the INS blocks get an
+/// identity transition and no noise): computed from the 3x3 blocks of F and G Q Gᵀ instead of n x n products —
+/// the per-step path of the filter (docs/performance.md §1). Equal to discretize(continuous_error_model(…)) up to
+/// rounding (tests/ins/test_error_state.cpp).
+void interval_error_model(const ErrorStateLayout& layout, const ImuSpec& spec, const NavState& before,
+                          const NavState& after, const ImuIncrement& inc, DiscreteErrorModel& out);
+
 /// Initial error covariance (diagonal) from 1-sigma position [m], velocity [m/s], attitude [rad] per axis and
 /// the spec's turn-on biases / scale-factor sigmas; other registered blocks are left zero for their owners.
 Eigen::MatrixXd initial_covariance(const ErrorStateLayout& layout, const ImuSpec& spec, double sigma_pos_m,

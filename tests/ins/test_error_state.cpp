@@ -196,6 +196,56 @@ TEST(ErrorState, DiscretePhiMatchesNonlinearPropagationOverOneSecondOfFootMotion
   EXPECT_LT(rel_half, kTolRel);
 }
 
+// The per-step path builds Φ and Q_d from 3x3 blocks (ins::interval_error_model with an output argument); it must
+// equal the generic n x n discretization of continuous_error_model at the interval mid-point, with and without the
+// optional scale blocks, with Gauss-Markov and random-walk biases, and leave foreign blocks (clock) untouched.
+TEST(ErrorState, BlockDiscretizationEqualsGenericSeries) {
+  constexpr double kTolRel = 1e-12;  // the same sums in another order
+  ImuIncrement inc;
+  inc.dt_s = 0.05;
+  inc.t1 = inc.t0.plus_s(inc.dt_s);
+  inc.alpha_b = Eigen::Vector3d(0.05, 0.2, -0.03);
+  inc.dtheta_b = inc.alpha_b;
+  inc.upsilon_b = Eigen::Vector3d(0.15, -0.1, -0.49);
+  inc.dv_b = inc.upsilon_b;
+  inc.dp_b = 0.5 * inc.dt_s * inc.upsilon_b;
+  const InsState x = sample_state();
+  const NavState after = mechanize(x.nav, inc);
+  for (const bool with_scale : {true, false}) {
+    for (const bool gauss_markov : {true, false}) {
+      const ErrorStateLayout l = with_scale ? layout_with_scale() : ErrorStateLayout();
+      ImuSpec sp = *imu_spec_preset("gx5_25");
+      sp.scale_tau_s = gauss_markov ? 1000.0 : 0.0;
+      sp.gyro_scale_sigma = 1e-3;
+      sp.accel_scale_sigma = 2e-3;
+      if (!gauss_markov) sp.gyro_bias_tau_s = sp.accel_bias_tau_s = 0.0;
+      const Eigen::Matrix3d R_mid = x.nav.q_e_b.slerp(0.5, after.q_e_b).toRotationMatrix();
+      const Eigen::Vector3d f_b = R_mid.transpose() * specific_force_increment_e(x.nav, inc) / inc.dt_s;
+      const auto generic = discretize(
+          continuous_error_model(l, sp, R_mid, 0.5 * (x.nav.p_eb_e + after.p_eb_e), f_b, inc.alpha_b / inc.dt_s),
+          inc.dt_s, QdMethod::kSeries);
+      DiscreteErrorModel fast;
+      interval_error_model(l, sp, x.nav, after, inc, fast);
+      ASSERT_EQ(fast.Phi.rows(), l.dim());
+      const double rel_phi = (fast.Phi - generic.Phi).norm() / generic.Phi.norm();
+      const double rel_qd = (fast.Qd - generic.Qd).norm() / generic.Qd.norm();
+      EXPECT_LT(rel_phi, kTolRel) << "scale " << with_scale << " gm " << gauss_markov;
+      EXPECT_LT(rel_qd, kTolRel) << "scale " << with_scale << " gm " << gauss_markov;
+      // The scale blocks must be driven (a fast path that dropped them would still match without them).
+      if (with_scale && gauss_markov) {
+        EXPECT_GT((fast.Qd.block<3, 3>(15, 15).norm()), 0.0);
+        EXPECT_GT((fast.Phi.block<3, 3>(kAtt.offset, 15).norm()), 0.0);
+      }
+      const int n = l.dim();
+      if (with_scale) {
+        EXPECT_TRUE(fast.Phi.bottomRightCorner(2, 2).isIdentity(0.0));
+        EXPECT_TRUE(fast.Qd.bottomRows(2).isZero(0.0));
+        EXPECT_TRUE(fast.Phi.block(n - 2, 0, 2, n - 2).isZero(0.0));
+      }
+    }
+  }
+}
+
 TEST(ErrorState, SeriesQdAgreesWithVanLoanAt20Hz) {
   constexpr double kTolRel = 2e-3;  // Van Loan's O(Δt⁴) terms (attitude noise reaching v and p through [f×])
   const auto l = layout_with_scale();
