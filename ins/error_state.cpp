@@ -242,16 +242,28 @@ void discretize_blocks(const Blocks3& F, const std::array<double, kMaxInsBlocks>
   }
 }
 
+// The nominal quantities F is evaluated at for one interval: attitude halfway, mid-point position, mean specific
+// force of the increment in e (the quantity the attitude error multiplies in eq. 3.2) and in b, mean rate.
+struct IntervalMidpoint {
+  Eigen::Matrix3d R;
+  Eigen::Vector3d p_mid, f_e, f_b, omega_b;
+};
+IntervalMidpoint interval_midpoint(const NavState& before, const NavState& after, const ImuIncrement& inc) {
+  IntervalMidpoint m;
+  m.R = before.q_e_b.slerp(0.5, after.q_e_b).toRotationMatrix();
+  m.p_mid = 0.5 * (before.p_eb_e + after.p_eb_e);
+  m.f_e = specific_force_increment_e(before, inc) / inc.dt_s;
+  m.f_b = m.R.transpose() * m.f_e;
+  m.omega_b = inc.alpha_b / inc.dt_s;
+  return m;
+}
+
 }  // namespace
 
 void interval_error_model(const ErrorStateLayout& layout, const ImuSpec& spec, const NavState& before,
                           const NavState& after, const ImuIncrement& inc, DiscreteErrorModel& out) {
   const double dt = inc.dt_s;
-  const Eigen::Matrix3d R = before.q_e_b.slerp(0.5, after.q_e_b).toRotationMatrix();
-  const Eigen::Vector3d p_mid = 0.5 * (before.p_eb_e + after.p_eb_e);
-  const Eigen::Vector3d f_e = specific_force_increment_e(before, inc) / dt;
-  const Eigen::Vector3d f_b = R.transpose() * f_e;
-  const Eigen::Vector3d omega_b = inc.alpha_b / dt;
+  const auto [R, p_mid, f_e, f_b, omega_b] = interval_midpoint(before, after, inc);
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
   const Eigen::Matrix3d W = skew(kOmegaIE_e);
   auto psd_gm = [](double sigma, double tau) { return tau > 0.0 ? 2.0 * sigma * sigma / tau : 0.0; };
@@ -301,14 +313,8 @@ DiscreteErrorModel interval_error_model(const ErrorStateLayout& layout, const Im
     interval_error_model(layout, spec, before, after, inc, d);
     return d;
   }
-  const double dt = inc.dt_s;
-  const Eigen::Matrix3d R_mid = before.q_e_b.slerp(0.5, after.q_e_b).toRotationMatrix();
-  const Eigen::Vector3d p_mid = 0.5 * (before.p_eb_e + after.p_eb_e);
-  // Mean specific force of the interval in e (the quantity the attitude error multiplies in eq. 3.2).
-  const Eigen::Vector3d f_e_mean = specific_force_increment_e(before, inc) / dt;
-  const Eigen::Vector3d f_b = R_mid.transpose() * f_e_mean;
-  const Eigen::Vector3d omega_b = inc.alpha_b / dt;
-  return discretize(continuous_error_model(layout, spec, R_mid, p_mid, f_b, omega_b), dt, method);
+  const IntervalMidpoint m = interval_midpoint(before, after, inc);
+  return discretize(continuous_error_model(layout, spec, m.R, m.p_mid, m.f_b, m.omega_b), inc.dt_s, method);
 }
 
 Eigen::MatrixXd initial_covariance(const ErrorStateLayout& layout, const ImuSpec& spec, double sigma_pos_m,
