@@ -45,6 +45,8 @@ struct McOptions {
   bool zupt_updates = true;        ///< false: the detector only segments steps
   bool step_velocity = false;      ///< seed 000 step-velocity aiding
   double leg_length_m = fusion::StepVelocityOptions{}.leg_length_m;
+  bool multipath_states = false;   ///< filter multipath GM states with the scenario's multipath model
+  bool scale_states = false;       ///< filter scale-factor states (the scenario's IMU spec)
 };
 
 // One finished run (what runs.csv shows), with its per-epoch errors.
@@ -110,6 +112,13 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
   c.zupt.form = mo.zupt_form;
   c.smoother_enabled = mo.smoother;
   fusion::EngineOptions o = io::engine_options(c);
+  if (mo.scale_states) o.estimate_scale_factors = true;
+  if (mo.multipath_states) {
+    // The filter's multipath model = the simulator's (docs/consistency.md §3).
+    o.multipath_sigma_m = sc.gnss.multipath_sigma_m;
+    o.multipath_tau_s = sc.gnss.multipath_tau_s;
+    o.multipath_cn0_ref_dbhz = sc.gnss.multipath_cn0_ref_dbhz;
+  }
   o.zupt_updates = mo.zupt_updates;
   o.step_velocity.enabled = mo.step_velocity;
   o.step_velocity.leg_length_m = mo.leg_length_m;
@@ -224,6 +233,8 @@ nlohmann::json summary_json(const eval::McSummary& m) {
           {"mean_nees_horizontal", m.mean_nees_horizontal},
           {"sigma_ratio_horizontal", m.sigma_ratio_horizontal},
           {"sigma_ratio_yaw", m.sigma_ratio_yaw},
+          {"sigma_ratio_horizontal_pooled", m.sigma_ratio_horizontal_pooled},
+          {"sigma_ratio_yaw_pooled", m.sigma_ratio_yaw_pooled},
           {"inside_3sigma_fraction", m.inside_3sigma_fraction},
           {"rms_horizontal_m", m.rms_horizontal_m}};
 }
@@ -391,6 +402,9 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
   cmd->add_option("--summary-from-s", mo->summary_from_s, "Summarize epochs from this time since the scenario start [s]");
   cmd->add_flag("!--no-smoother", mo->smoother, "Forward filter only");
   cmd->add_flag("!--no-zupt-updates", mo->zupt_updates, "The ZUPT detector only segments steps (no ZUPT updates)");
+  cmd->add_flag("--multipath-states", mo->multipath_states,
+                "Filter code-multipath Gauss-Markov states with the scenario's multipath sigma/tau/C/N0 reference");
+  cmd->add_flag("--scale-states", mo->scale_states, "Filter gyro/accelerometer scale-factor states");
   cmd->add_flag("--step-velocity", mo->step_velocity, "Seed 000 step-averaged velocity aiding");
   cmd->add_option("--leg-length-m", mo->leg_length_m, "Inverted-pendulum length l of the step-length model [m]")
       ->check(CLI::Range(0.05, 3.0));

@@ -107,9 +107,13 @@ McSummary summarize(const std::vector<McEpochStats>& epochs, int runs, double t_
   McSummary m;
   m.runs = runs;
   double in_h = 0, in_y = 0, above = 0, below = 0, nees = 0, sv = 0, fv = 0, svy = 0, fvy = 0, in3 = 0, h2 = 0, w = 0;
+  std::vector<double> ratio_h, ratio_y;
   for (const McEpochStats& e : epochs) {
     if (e.t_s < t_from_s) continue;
     ++m.epochs;
+    const double fh = e.filter_sd_ned_m.head<2>().norm();
+    if (fh > 0) ratio_h.push_back(e.sample_sd_ned_m.head<2>().norm() / fh);
+    if (e.filter_sd_yaw_rad > 0) ratio_y.push_back(e.sample_sd_yaw_rad / e.filter_sd_yaw_rad);
     in_h += e.nees_horizontal >= e.nees_lo_2dof && e.nees_horizontal <= e.nees_hi_2dof;
     above += e.nees_horizontal > e.nees_hi_2dof;
     below += e.nees_horizontal < e.nees_lo_2dof;
@@ -130,8 +134,15 @@ McSummary summarize(const std::vector<McEpochStats>& epochs, int runs, double t_
   m.nees_above_band_fraction = above / k;
   m.nees_below_band_fraction = below / k;
   m.mean_nees_horizontal = nees / k;
-  m.sigma_ratio_horizontal = fv > 0 ? std::sqrt(sv / fv) : 0.0;
-  m.sigma_ratio_yaw = fvy > 0 ? std::sqrt(svy / fvy) : 0.0;
+  m.sigma_ratio_horizontal_pooled = fv > 0 ? std::sqrt(sv / fv) : 0.0;
+  m.sigma_ratio_yaw_pooled = fvy > 0 ? std::sqrt(svy / fvy) : 0.0;
+  auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  m.sigma_ratio_horizontal = median(ratio_h);
+  m.sigma_ratio_yaw = median(ratio_y);
   m.inside_3sigma_fraction = in3 / w;
   m.rms_horizontal_m = std::sqrt(h2 / w);
   return m;

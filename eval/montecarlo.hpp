@@ -52,8 +52,10 @@ struct McSummary {
   double nees_above_band_fraction = 0.0;       ///< horizontal NEES above the band (filter optimistic)
   double nees_below_band_fraction = 0.0;       ///< below the band (filter pessimistic)
   double mean_nees_horizontal = 0.0;           ///< time average of the average NEES (2 for a consistent filter)
-  double sigma_ratio_horizontal = 0.0;         ///< √(Σ sample var N,E / Σ mean filter var N,E) over epochs
-  double sigma_ratio_yaw = 0.0;                ///< the same for yaw
+  double sigma_ratio_horizontal = 0.0;         ///< median over epochs of √((s_N² + s_E²)/(σ_N² + σ_E²)), s sample σ
+  double sigma_ratio_yaw = 0.0;                ///< median over epochs of s_ψ / σ_ψ
+  double sigma_ratio_horizontal_pooled = 0.0;  ///< √(Σ sample var N,E / Σ mean filter var N,E) over epochs
+  double sigma_ratio_yaw_pooled = 0.0;         ///< the same for yaw
   double inside_3sigma_fraction = 0.0;         ///< share of (run, epoch) pairs with N and E inside 3σ
   double rms_horizontal_m = 0.0;               ///< RMS horizontal error over all runs and epochs [m]
 };

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <type_traits>
 
 #include "core/geodesy.hpp"
@@ -85,6 +86,14 @@ struct Row {
 class Filter {
  public:
   Filter(const EngineOptions& o, int n_clocks) : o_(o) {
+    if (o.estimate_scale_factors) {  // the INS error model owns these blocks (docs/error_state.md)
+      for (const char* name : {ins::kScaleGyroBlock, ins::kScaleAccBlock}) {
+        if (auto b = layout_.add(name, 3); !b) {
+          problem_ = b.error().message;
+          return;
+        }
+      }
+    }
     if (o.mode == Mode::kTightlyCoupled) {
       for (int i = 0; i < n_clocks; ++i) {
         auto b = layout_.add("clock_" + std::to_string(i), 1);
@@ -100,6 +109,17 @@ class Filter {
         return;
       }
       drift_block_ = *d;
+      if (o.multipath_sigma_m > 0.0 && o.multipath_slots > 0) {
+        auto b = layout_.add("multipath", o.multipath_slots);
+        if (!b) {
+          problem_ = b.error().message;
+          return;
+        }
+        mp_block_ = *b;
+        mp_value_.assign(o.multipath_slots, 0.0);
+        mp_sat_.assign(o.multipath_slots, gnss::SatId{});
+        mp_last_ns_.assign(o.multipath_slots, kNeverNs);
+      }
     }
     clock_m_.assign(n_clocks, 0.0);
   }
@@ -120,6 +140,7 @@ class Filter {
     P_.block<3, 3>(ins::kAtt.offset, ins::kAtt.offset) = Ren * att_n * Ren.transpose();
     for (const auto& b : clock_blocks_) P_(b.offset, b.offset) = 1e12;  // unknown until the first GNSS epoch
     if (o_.mode == Mode::kTightlyCoupled) P_(drift_block_.offset, drift_block_.offset) = 1e6;
+    for (int i = 0; i < mp_block_.dim; ++i) P_(mp_block_.offset + i, mp_block_.offset + i) = 1.0;  // unit GM
   }
 
   // Replace the variance of a 3-state block (position [m], velocity [m/s]) by sigma² per axis, uncorrelated
@@ -147,6 +168,16 @@ class Filter {
         m.Qd(c, d) += qd * dt * dt / 2.0;
         m.Qd(d, c) += qd * dt * dt / 2.0;
         clock_m_[i] += drift_mps_ * dt;
+      }
+    }
+    // Code multipath (docs/consistency.md eq. M.1): u(t + dt) = e u(t) + w, e = exp(−dt/τ), var w = 1 − e².
+    if (mp_block_.dim > 0) {
+      const double e = std::exp(-dt / o_.multipath_tau_s);
+      for (int i = 0; i < mp_block_.dim; ++i) {
+        const int k = mp_block_.offset + i;
+        m.Phi(k, k) = e;
+        m.Qd(k, k) += 1.0 - e * e;
+        mp_value_[i] *= e;
       }
     }
     Phi_sparse_.assign(m.Phi);
@@ -199,7 +230,44 @@ class Filter {
     x_ = ins::boxplus(x_, dx, layout_);
     for (size_t i = 0; i < clock_blocks_.size(); ++i) clock_m_[i] += dx(clock_blocks_[i].offset);
     if (o_.mode == Mode::kTightlyCoupled) drift_mps_ += dx(drift_block_.offset);
+    for (int i = 0; i < mp_block_.dim; ++i) mp_value_[i] += dx(mp_block_.offset + i);
   }
+
+  /// The multipath state of satellite `sat` measured at rover epoch t_ns [GPST ns]: its slot, or (satellite new, or
+  /// not measured for longer than multipath_reset_gap_s) a slot restarted as a fresh unit-variance state — the
+  /// least recently used slot not yet used at this epoch. `reset` tells whether it was restarted. -1 when every slot
+  /// is in use at this epoch (that satellite's code is then treated as white, docs/consistency.md §3).
+  int multipath_slot(const gnss::SatId& sat, int64_t t_ns, bool& reset) {
+    reset = false;
+    const int64_t gap_ns = static_cast<int64_t>(o_.multipath_reset_gap_s * 1e9);
+    int lru = -1;
+    for (int i = 0; i < mp_block_.dim; ++i) {
+      if (mp_last_ns_[i] != kNeverNs && mp_sat_[i] == sat) {
+        if (mp_last_ns_[i] == t_ns || t_ns - mp_last_ns_[i] <= gap_ns) {
+          mp_last_ns_[i] = t_ns;
+          return i;
+        }
+        lru = i;  // the same satellite after a long gap: restart its own slot
+        break;
+      }
+      if (mp_last_ns_[i] < t_ns && (lru < 0 || mp_last_ns_[i] < mp_last_ns_[lru])) lru = i;
+    }
+    if (lru < 0) return -1;
+    const int k = mp_block_.offset + lru;
+    mp_sat_[lru] = sat;
+    mp_last_ns_[lru] = t_ns;
+    mp_value_[lru] = 0.0;
+    P_.row(k).setZero();
+    P_.col(k).setZero();
+    P_(k, k) = 1.0;
+    fold_reset_into_prior(k, 1.0);  // a fresh variable for the smoother too (docs/fusion.md eq. 12.11)
+    reset = true;
+    return lru;
+  }
+  /// State index of multipath slot `slot`; its nominal value u (closed loop: normally 0 after each update, decayed).
+  int multipath_index(int slot) const { return mp_block_.offset + slot; }
+  double multipath_value(int slot) const { return mp_value_[slot]; }
+  bool has_multipath() const { return mp_block_.dim > 0; }
 
   // P <- J P J^T with J = I except the (velocity, attitude) block = A (docs/fusion.md eq. 5.9).
   void reexpress_velocity_attitude(const Eigen::Matrix3d& A) {
@@ -319,6 +387,12 @@ class Filter {
   ErrorMatrix tmp_;
   std::vector<double> clock_m_;
   double drift_mps_ = 0.0;
+  // Code multipath Gauss-Markov states (docs/consistency.md §3): block, nominal values, satellite and last epoch.
+  static constexpr int64_t kNeverNs = std::numeric_limits<int64_t>::min();
+  ins::Block mp_block_{0, 0};
+  std::vector<double> mp_value_;
+  std::vector<gnss::SatId> mp_sat_;
+  std::vector<int64_t> mp_last_ns_;
   // Smoother: the posterior at the start of the current run of steps, the run's composed transition, the last
   // step's prior and update map (eqs. 12.2, 12.13).
   bool recording_ = false;
@@ -830,7 +904,24 @@ class Runner {
       rc.h = ins::ErrorRowVector::Zero(n);
       rc.h.segment<3>(ins::kPos.offset) = code.J_p;
       rc.h(f.clock_offset(slot)) = code.J_clock;
-      code_res_by_slot[slot].push_back(code.residual);
+      if (f.has_multipath()) {
+        // Code multipath σ_mp(C/N0) u_s (docs/consistency.md eq. M.2); SD: rover and base in quadrature.
+        auto mp_sigma = [&](double cn0) {
+          const double c = std::isnan(cn0) ? o_.multipath_cn0_ref_dbhz : cn0;
+          return o_.multipath_sigma_m * std::pow(10.0, std::max(0.0, o_.multipath_cn0_ref_dbhz - c) / 20.0);
+        };
+        const double s_mp = sd_ ? std::hypot(mp_sigma(so.cn0_dbhz), mp_sigma(cn0_b)) : mp_sigma(so.cn0_dbhz);
+        bool reset = false;
+        const int ms = f.multipath_slot(so.sat, re.time.ns(), reset);
+        if (reset) ++sum.multipath_resets;
+        if (ms >= 0) {
+          rc.h(f.multipath_index(ms)) = s_mp;
+          rc.residual -= s_mp * f.multipath_value(ms);
+        } else {
+          rc.sigma = std::hypot(rc.sigma, s_mp);
+        }
+      }
+      code_res_by_slot[slot].push_back(rc.residual);
       rows.push_back(rc);
       if (have_rate) {
         Row rd;

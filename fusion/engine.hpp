@@ -62,6 +62,19 @@ struct EngineOptions {
   double antenna_sigma_vertical_m = 0.2;
   double antenna_velocity_sigma_horizontal_mps = 1.0;  ///< foot vs body velocity at the GNSS epoch [m/s]
   double antenna_velocity_sigma_vertical_mps = 0.3;
+  /// Estimate gyro and accelerometer scale-factor errors (ins layout blocks scale_gyro, scale_acc with the spec's
+  /// *_scale_sigma and scale_tau_s). Off: scale-factor errors are not modelled (docs/consistency.md §3).
+  bool estimate_scale_factors = false;
+  /// Code multipath as one unit-variance first-order Gauss-Markov state u_s per tracked satellite (docs/consistency.md
+  /// §3): the code error gets σ_mp · u_s, σ_mp = multipath_sigma_m · 10^(max(0, cn0_ref − C/N0)/20) per receiver
+  /// (rover and base in quadrature for SD). multipath_sigma_m = 0: no multipath states (code errors white).
+  double multipath_sigma_m = 0.0;
+  double multipath_tau_s = 20.0;          ///< correlation time of u_s [s]
+  double multipath_cn0_ref_dbhz = 45.0;   ///< C/N0 above which σ_mp no longer decreases [dB-Hz]
+  int multipath_slots = 12;               ///< states = satellites tracked at once (more are left white, σ inflated)
+  /// A satellite's state is reset to a fresh unit variance when it was not measured for longer than this [s]
+  /// (re-acquisition: new multipath); shorter gaps keep it, decayed by the Gauss-Markov transition.
+  double multipath_reset_gap_s = 20.0;
   double clock_psd_m2_per_s = 1.0;            ///< differential clock random walk PSD [m^2/s]
   double drift_psd_m2_per_s3 = 0.1;           ///< differential drift random walk PSD [m^2/s^3]
   double clock_jump_threshold_m = 300.0;      ///< median innovation above this resets the clock (ms jumps)
@@ -114,6 +127,7 @@ struct EngineSummary {
   long gnss_epochs_before_start = 0; ///< before initialization / outside the IMU span
   long gnss_epochs_masked = 0;
   long clock_resets = 0;
+  long multipath_resets = 0;         ///< multipath states (re)started: a satellite took a slot or returned after a gap
   std::map<std::string, long> code_used_rejected;     ///< "used", "fault", "low_cn0", "no_ephemeris", ...
   std::map<std::string, long> doppler_used_rejected;
   std::string initialization;        ///< how the state was initialized and when

@@ -117,6 +117,13 @@ std::string to_yaml(const RunConfig& c) {
     << YAML::Value << c.fault_rejection_probability << YAML::EndMap;
   e << YAML::Key << "smoother" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled" << YAML::Value
     << c.smoother_enabled << YAML::EndMap;
+  e << YAML::Key << "multipath" << YAML::Value << YAML::BeginMap << YAML::Key << "states" << YAML::Value
+    << c.multipath.states << YAML::Key << "sigma_m" << YAML::Value << c.multipath.sigma_m << YAML::Key << "tau_s"
+    << YAML::Value << c.multipath.tau_s << YAML::Key << "cn0_ref_dbhz" << YAML::Value << c.multipath.cn0_ref_dbhz
+    << YAML::Key << "slots" << YAML::Value << c.multipath.slots << YAML::Key << "reset_gap_s" << YAML::Value
+    << c.multipath.reset_gap_s << YAML::EndMap;
+  e << YAML::Key << "scale_factors" << YAML::Value << YAML::BeginMap << YAML::Key << "states" << YAML::Value
+    << c.scale_factors.states << YAML::EndMap;
   e << YAML::Key << "output" << YAML::Value << YAML::BeginMap << YAML::Key << "rate_hz" << YAML::Value
     << c.output.rate_hz << YAML::Key << "formats" << YAML::Value << YAML::Flow << c.output.formats << YAML::EndMap;
   e << YAML::EndMap;

@@ -116,6 +116,21 @@ struct ClockConfig {
   double jump_threshold_m = 300.0;
 };
 
+/// `multipath:` section: code-multipath Gauss-Markov states of the tc filter (docs/consistency.md §3).
+struct MultipathConfig {
+  bool states = false;              ///< one unit-variance GM state per tracked satellite
+  double sigma_m = 0.28;            ///< multipath σ at C/N0 >= cn0_ref_dbhz [m] (per receiver)
+  double tau_s = 20.0;              ///< correlation time [s]
+  double cn0_ref_dbhz = 45.0;       ///< below, σ grows as 10^((ref − C/N0)/20)
+  int slots = 12;                   ///< satellites with a state at once
+  double reset_gap_s = 20.0;        ///< a satellite unseen for longer restarts its state [s]
+};
+
+/// `scale_factors:` section: IMU scale-factor states (the spec's *_scale_sigma, docs/consistency.md §3).
+struct ScaleFactorConfig {
+  bool states = false;
+};
+
 /// `output:` section.
 struct OutputConfig {
   double rate_hz = 1.0;                      ///< solution rows per second
@@ -137,6 +152,8 @@ struct RunConfig {
   double fault_rejection_probability = 0.999;  ///< chi-square test probability of the innovation check
   bool smoother_enabled = true;
   OutputConfig output;
+  MultipathConfig multipath;
+  ScaleFactorConfig scale_factors;
 };
 
 /// Read and validate a run configuration; every problem is reported at once ("file:line: yaml.path: what").

@@ -86,6 +86,20 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
     YamlMap s = top.map("smoother");
     s.boolean("enabled", out.smoother_enabled);
   }
+  {
+    YamlMap m = top.map("multipath");
+    MultipathConfig& c = out.multipath;
+    m.boolean("states", c.states);
+    m.number("sigma_m", c.sigma_m, false, 1e-3, 100.0);
+    m.number("tau_s", c.tau_s, false, 0.1, 1e5);
+    m.number("cn0_ref_dbhz", c.cn0_ref_dbhz, false, 0.0, 80.0);
+    m.integer("slots", c.slots, false, 1, 20);
+    m.number("reset_gap_s", c.reset_gap_s, false, 0.0, 1e5);
+  }
+  {
+    YamlMap s = top.map("scale_factors");
+    s.boolean("states", out.scale_factors.states);
+  }
 }
 
 }  // namespace pednav::io

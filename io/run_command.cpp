@@ -128,6 +128,12 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.fault_probability = c.fault_rejection_probability;
   o.output_rate_hz = c.output.rate_hz;
   o.smoother_enabled = c.smoother_enabled;
+  o.multipath_sigma_m = c.multipath.states ? c.multipath.sigma_m : 0.0;
+  o.multipath_tau_s = c.multipath.tau_s;
+  o.multipath_cn0_ref_dbhz = c.multipath.cn0_ref_dbhz;
+  o.multipath_slots = c.multipath.slots;
+  o.multipath_reset_gap_s = c.multipath.reset_gap_s;
+  o.estimate_scale_factors = c.scale_factors.states;
   return o;
 }
 

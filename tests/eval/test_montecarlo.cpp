@@ -77,6 +77,8 @@ TEST(MonteCarloStats, ConsistentRunsAreInsideTheBand) {
   EXPECT_NEAR(s.mean_nees_horizontal, 2.0, 2.0 * kRatioTol);
   EXPECT_NEAR(s.sigma_ratio_horizontal, 1.0, kRatioTol);
   EXPECT_NEAR(s.sigma_ratio_yaw, 1.0, kRatioTol);
+  EXPECT_NEAR(s.sigma_ratio_horizontal_pooled, 1.0, kRatioTol);
+  EXPECT_NEAR(s.sigma_ratio_yaw_pooled, 1.0, kRatioTol);
   EXPECT_GT(s.inside_3sigma_fraction, 0.98);
   // Distance is the mean over runs; the sample σ of each axis follows P.
   EXPECT_NEAR(st[100].distance_m, 110.0, 1e-9);
@@ -91,6 +93,7 @@ TEST(MonteCarloStats, OptimisticFilterIsAboveTheBand) {
   EXPECT_NEAR(s.mean_nees_horizontal, 2.0 * 1.5 * 1.5, 2.0 * 1.5 * 1.5 * kRatioTol);
   EXPECT_NEAR(s.sigma_ratio_horizontal, 1.5, 1.5 * kRatioTol);
   EXPECT_NEAR(s.sigma_ratio_yaw, 1.5, 1.5 * kRatioTol);
+  EXPECT_NEAR(s.sigma_ratio_horizontal_pooled, 1.5, 1.5 * kRatioTol);
 }
 
 TEST(MonteCarloStats, EpochsMissingInManyRunsAreLeftOut) {

@@ -50,7 +50,8 @@ TEST(Allocations, CounterSeesAllocations) {
   delete v;
 }
 
-TEST(Allocations, NoHeapAllocationPerMechanizationStepOrGnssEpoch) {
+// states: the optional multipath Gauss-Markov and scale-factor states on (docs/consistency.md §3).
+void check_no_allocation_per_step(bool states) {
   auto file = io::parse_scenario(kWalk, "alloc_walk.yaml", ".");
   ASSERT_TRUE(file.has_value()) << file.error().message;
   auto sim = sim::simulate(file->scenario);
@@ -60,6 +61,10 @@ TEST(Allocations, NoHeapAllocationPerMechanizationStepOrGnssEpoch) {
   c.imu.spec = file->scenario.imu.spec;
   fusion::EngineOptions o = io::engine_options(c);
   ASSERT_TRUE(o.smoother_enabled);
+  if (states) {
+    o.multipath_sigma_m = file->scenario.gnss.multipath_sigma_m;
+    o.estimate_scale_factors = true;
+  }
   o.base_position_e = sim->gnss.p_base_e;
   fusion::EngineInputs in;
   in.imu = &sim->imu;
@@ -111,7 +116,14 @@ TEST(Allocations, NoHeapAllocationPerMechanizationStepOrGnssEpoch) {
   EXPECT_GT(steps, 2000);
   EXPECT_GT(gnss_steps, 100);
   EXPECT_EQ(allocations, 0);
+  if (states) {
+    EXPECT_GT(r->summary.multipath_resets, 0);
+  }
 }
+
+TEST(Allocations, NoHeapAllocationPerMechanizationStepOrGnssEpoch) { check_no_allocation_per_step(false); }
+
+TEST(Allocations, NoHeapAllocationWithMultipathAndScaleFactorStates) { check_no_allocation_per_step(true); }
 
 }  // namespace
 }  // namespace pednav

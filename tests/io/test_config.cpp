@@ -94,3 +94,31 @@ TEST(Config, ResolvedYamlParsesBackToTheSameConfig) {
 
 }  // namespace
 }  // namespace pednav::io
+
+namespace pednav::io {
+namespace {
+
+TEST(Config, MultipathAndScaleFactorStateKeys) {
+  auto cfg = parse(
+      "mode: gnss\nrover_obs: r.obs\nnav: n.nav\nmultipath:\n  states: true\n  sigma_m: 0.5\n  tau_s: 30\n"
+      "  slots: 10\nscale_factors:\n  states: true\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_TRUE(cfg->multipath.states);
+  EXPECT_DOUBLE_EQ(cfg->multipath.sigma_m, 0.5);
+  EXPECT_DOUBLE_EQ(cfg->multipath.tau_s, 30.0);
+  EXPECT_EQ(cfg->multipath.slots, 10);
+  EXPECT_TRUE(cfg->scale_factors.states);
+  // The resolved configuration carries them (config.resolved.yaml reads back to the same values).
+  auto again = parse(to_yaml(*cfg));
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_TRUE(again->multipath.states);
+  EXPECT_EQ(again->multipath.slots, 10);
+  EXPECT_TRUE(again->scale_factors.states);
+  auto bad = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\nmultipath:\n  slots: 40\n  tau_s: 0\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("multipath.slots: value 40 is out of range"));
+  EXPECT_THAT(bad.error().message, HasSubstr("multipath.tau_s: value 0 is out of range"));
+}
+
+}  // namespace
+}  // namespace pednav::io
