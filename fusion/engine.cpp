@@ -140,7 +140,11 @@ class Filter {
     P_.block<3, 3>(ins::kAtt.offset, ins::kAtt.offset) = Ren * att_n * Ren.transpose();
     for (const auto& b : clock_blocks_) P_(b.offset, b.offset) = 1e12;  // unknown until the first GNSS epoch
     if (o_.mode == Mode::kTightlyCoupled) P_(drift_block_.offset, drift_block_.offset) = 1e6;
-    for (int i = 0; i < mp_block_.dim; ++i) P_(mp_block_.offset + i, mp_block_.offset + i) = 1.0;  // unit GM
+    for (int i = 0; i < mp_block_.dim; ++i) {  // unit-variance GM, no satellite yet (also at a re-initialization)
+      P_(mp_block_.offset + i, mp_block_.offset + i) = 1.0;
+      mp_value_[i] = 0.0;
+      mp_last_ns_[i] = kNeverNs;
+    }
   }
 
   // Replace the variance of a 3-state block (position [m], velocity [m/s]) by sigma² per axis, uncorrelated
@@ -910,7 +914,7 @@ class Runner {
           const double c = std::isnan(cn0) ? o_.multipath_cn0_ref_dbhz : cn0;
           return o_.multipath_sigma_m * std::pow(10.0, std::max(0.0, o_.multipath_cn0_ref_dbhz - c) / 20.0);
         };
-        const double s_mp = sd_ ? std::hypot(mp_sigma(so.cn0_dbhz), mp_sigma(cn0_b)) : mp_sigma(so.cn0_dbhz);
+        const double s_mp = sd ? std::hypot(mp_sigma(so.cn0_dbhz), mp_sigma(cn0_b)) : mp_sigma(so.cn0_dbhz);
         bool reset = false;
         const int ms = f.multipath_slot(so.sat, re.time.ns(), reset);
         if (reset) ++sum.multipath_resets;
