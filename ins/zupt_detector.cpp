@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 
 namespace pednav::ins {
 namespace {
@@ -221,9 +222,24 @@ std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& s, const Z
     }
   } else if (o.detector == "shoe") {
     const std::vector<double> t = shoe_statistic(s, o);
+    // Gait-adaptive threshold: a fast gait's stance never gets below γ (LORD #35: min T per stance up to 219), so the
+    // threshold follows the local minimum of T (the stance of the current step) when that is above γ / factor.
+    const int hw = o.shoe_adaptive_factor > 0 ? half_window(s, o.shoe_adaptive_window_s) : 0;
+    std::deque<int> mins;  // indices of increasing T over the sliding window (monotone queue)
+    int next = 0;
     for (int k = 0; k < n; ++k) {
       d[k].statistic = t[k];
-      d[k].stance = t[k] < o.shoe_threshold;
+      double thr = o.shoe_threshold;
+      if (hw > 0) {
+        for (; next < n && next <= k + hw; ++next) {
+          while (!mins.empty() && t[mins.back()] >= t[next]) mins.pop_back();
+          mins.push_back(next);
+        }
+        while (mins.front() < k - hw) mins.pop_front();
+        const double m = t[mins.front()];
+        if (m < o.shoe_adaptive_max) thr = std::max(thr, o.shoe_adaptive_factor * m);
+      }
+      d[k].stance = t[k] < thr;
     }
   } else {
     // seed 004 eq. 1: sigma_{k} = std of |f| over the window; stance if sigma < threshold and t_k - t_s > Δt,

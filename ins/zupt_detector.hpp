@@ -25,6 +25,11 @@ struct ZuptDetectorOptions {
   double shoe_sigma_accel_mps2 = 0.5;
   double shoe_sigma_gyro_radps = 0.1;
   double shoe_threshold = 10.0;     ///< γ
+  /// Gait-adaptive SHOE (docs/zupt.md §1): stance when T_k < max(γ, factor · m_k), m_k = min of T over a centred
+  /// window of shoe_adaptive_window_s, and m_k < shoe_adaptive_max (a stance must be near). <= 0: plain SHOE.
+  double shoe_adaptive_factor = 0.0;
+  double shoe_adaptive_window_s = 0.6;  ///< about half a gait cycle either side at a fast gait [s]
+  double shoe_adaptive_max = 1000.0;    ///< largest stance minimum of T accepted (|ω| about 3 rad/s at σω 0.1 rad/s)
   // ARE and MAG (Skog et al. 2010 eq. 8, 9), same window W and sigmas as SHOE:
   // ARE T = 1/(σω² W) Σ|ω|² < γ_are; MAG T = 1/(σa² W) Σ(|f| - g)² < γ_mag.
   double are_threshold = 10.0;      ///< γ_are (10 with σω 0.1 rad/s: RMS rate below 0.32 rad/s)

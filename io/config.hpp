@@ -84,6 +84,8 @@ struct ZuptConfig {
   std::string hmm_decoder = "viterbi";    ///< viterbi | forward
   double hmm_rest_s = 0.5;                ///< rest of at least this long is stance (ins::ZuptDetectorOptions)
   double hmm_refine_factor = 0.0;         ///< stance shortening by SHOE, adaptive threshold (0: off)
+  double shoe_adaptive_factor = 0.0;      ///< gait-adaptive SHOE threshold factor (0: off; ins::ZuptDetectorOptions)
+  double shoe_adaptive_window_s = 0.6;
   double sigma_mps = 0.02;                ///< ZUPT measurement noise per axis
   bool zaru = true;
   double zaru_sigma_radps = 0.01;         ///< key zaru_sigma_deg_per_s

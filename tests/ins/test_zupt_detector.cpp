@@ -230,6 +230,13 @@ TEST(ZuptDetector, HmmRefineThresholdAdaptsToAFootThatNeverStops) {
   const StanceCount c = count(g, detect_stance(g.samples, o));
   EXPECT_EQ(c.runs, g.stances);
   EXPECT_LE(c.rolling, 8 * g.stances);
+  // The gait-adaptive SHOE (threshold max(γ, 2 × the minimum of T within ±0.5 s)) finds them without the HMM.
+  o.detector = "shoe";
+  o.shoe_adaptive_factor = 2.0;
+  o.shoe_adaptive_window_s = 1.0;
+  const StanceCount a = count(g, detect_stance(g.samples, o));
+  EXPECT_EQ(a.runs, g.stances);
+  EXPECT_LE(a.rolling, 8 * g.stances);
 }
 
 }  // namespace
