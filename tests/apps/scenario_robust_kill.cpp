@@ -26,20 +26,7 @@ constexpr int kKills = 30;  // 10 per signal
 constexpr unsigned kSeed = 2026;
 constexpr double kRunTimeout_s = 120.0;
 
-constexpr const char* kWalkYaml = R"(
-name: robust_kill
-seed: 9
-start: {gps_week: 2300, gps_tow_s: 510000}
-origin: {lat_deg: 52.2, lon_deg: 0.1, h_m: 20}
-route:
-  static_start_s: 20
-  static_end_s: 5
-  shape: {type: rectangle, east_m: 30, north_m: 20, laps: 2}
-gait: {speed_mps: 1.2, cycle_s: 1.1}
-imu: {rate_hz: 100, spec: crista, errors: true}
-gnss: {base_offset_enu_m: [100, 50, 2]}
-output: {truth_rate_hz: 10}
-)";
+const std::string kWalkYaml = test::small_rectangle_walk_yaml("robust_kill", 9, 510000, "{lat_deg: 52.2, lon_deg: 0.1, h_m: 20}", 2);
 
 // Start `pednav run config -o out` as a child process; returns its pid.
 pid_t start_run(const std::string& config, const std::string& out) {

@@ -28,20 +28,7 @@ constexpr int kReadOffsets = 60;   // cut positions per file for the reader
 constexpr int kRunOffsets = 3;     // cut positions per file for a whole `pednav run`
 constexpr unsigned kSeed = 11;
 
-constexpr const char* kShortWalkYaml = R"(
-name: robust_truncation
-seed: 5
-start: {gps_week: 2300, gps_tow_s: 500000}
-origin: {lat_deg: 40.4, lon_deg: -3.7, h_m: 650}
-route:
-  static_start_s: 20
-  static_end_s: 5
-  shape: {type: rectangle, east_m: 30, north_m: 20, laps: 1}
-gait: {speed_mps: 1.2, cycle_s: 1.1}
-imu: {rate_hz: 100, spec: crista, errors: true}
-gnss: {base_offset_enu_m: [100, 50, 2]}
-output: {truth_rate_hz: 10}
-)";
+const std::string kShortWalkYaml = test::small_rectangle_walk_yaml("robust_truncation", 5, 500000, "{lat_deg: 40.4, lon_deg: -3.7, h_m: 650}", 1);
 
 const std::string& sim_dir() {
   static const std::string d = [] {

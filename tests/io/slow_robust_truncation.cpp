@@ -24,20 +24,7 @@ using ::testing::HasSubstr;
 
 constexpr int kImuLineStride = 20;  // IMU log: every 20th line (the reader is exercised at every byte in unit tests)
 
-constexpr const char* kWalkYaml = R"(
-name: robust_truncation_sweep
-seed: 6
-start: {gps_week: 2300, gps_tow_s: 520000}
-origin: {lat_deg: 60.2, lon_deg: 24.9, h_m: 20}
-route:
-  static_start_s: 20
-  static_end_s: 5
-  shape: {type: rectangle, east_m: 30, north_m: 20, laps: 1}
-gait: {speed_mps: 1.2, cycle_s: 1.1}
-imu: {rate_hz: 100, spec: crista, errors: true}
-gnss: {base_offset_enu_m: [100, 50, 2]}
-output: {truth_rate_hz: 10}
-)";
+const std::string kWalkYaml = test::small_rectangle_walk_yaml("robust_truncation_sweep", 6, 520000, "{lat_deg: 60.2, lon_deg: 24.9, h_m: 20}", 1);
 
 bool same(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
 

@@ -54,6 +54,19 @@ gnss: {enabled: false}
 )";
 
 /// Parse a scenario text (fails the test on error).
+/// A short walk of the robustness tests: `laps` laps of a 30 m x 20 m rectangle after a 20 s static start, Crista
+/// IMU at 100 Hz with errors, 1 Hz rover + base (base 100 m E, 50 m N, 2 m up), truth at 10 Hz.
+inline std::string small_rectangle_walk_yaml(const std::string& name, int seed, int gps_tow_s, const char* origin,
+                                             int laps) {
+  std::ostringstream y;
+  y << "\nname: " << name << "\nseed: " << seed << "\nstart: {gps_week: 2300, gps_tow_s: " << gps_tow_s
+    << "}\norigin: " << origin
+    << "\nroute:\n  static_start_s: 20\n  static_end_s: 5\n  shape: {type: rectangle, east_m: 30, north_m: 20, laps: "
+    << laps << "}\ngait: {speed_mps: 1.2, cycle_s: 1.1}\nimu: {rate_hz: 100, spec: crista, errors: true}\n"
+    << "gnss: {base_offset_enu_m: [100, 50, 2]}\noutput: {truth_rate_hz: 10}\n";
+  return y.str();
+}
+
 inline io::ScenarioFile scenario_from_text(const std::string& text) {
   auto sc = io::parse_scenario(text, "test.yaml", ".");
   EXPECT_TRUE(sc.has_value()) << (sc ? "" : sc.error().message);
