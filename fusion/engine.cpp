@@ -419,6 +419,9 @@ double median(std::vector<double>& v) {
 struct PassOptions {
   bool gnss = true;
   std::optional<GpsTime> stop;
+  /// Stop after the first mechanization epoch whose IMU position is this far (horizontally) from the start
+  /// (the heading pass: the distance walked does not depend on the unknown heading). Output of that epoch included.
+  std::optional<double> stop_displacement_m;
 };
 
 class Runner {
@@ -605,9 +608,16 @@ class Runner {
       if (in_.on_step) in_.on_step(inc.t1);
     };
 
+    const Vector3d p_start_e = nav0.p_eb_e;
+    const Vector3d up_start_e = p_start_e.normalized();
+    auto displaced = [&] {
+      const Vector3d d = f.x().nav.p_eb_e - p_start_e;
+      return (d - d.dot(up_start_e) * up_start_e).norm() >= *po.stop_displacement_m;
+    };
     for (; sample_index < samples.size(); ++sample_index) {
       const ins::ImuSample& raw = samples[sample_index];
       if (po.stop && raw.t > *po.stop) break;
+      if (po.stop_displacement_m && displaced()) break;
       if (!raw.omega_ib_b.allFinite() || !raw.f_ib_b.allFinite()) {
         count(sum.imu_rejected, "non_finite");
         continue;
@@ -1103,6 +1113,14 @@ class Runner {
 
 // 2D rigid fit (rotation about the vertical + translation) of src onto dst (ENU); returns the rotation angle
 // (counter-clockwise, rad) and the RMS of the residuals [m].
+// printf-style message (the engine's texts; fusion/ has no logging or fmt dependency).
+template <typename... Args>
+std::string fmt_message(const char* format, Args... args) {
+  char buf[400];
+  std::snprintf(buf, sizeof buf, format, args...);
+  return buf;
+}
+
 std::pair<double, double> fit_yaw(const std::vector<Vector3d>& src, const std::vector<Vector3d>& dst) {
   Vector3d ms = Vector3d::Zero(), md = Vector3d::Zero();
   for (size_t i = 0; i < src.size(); ++i) ms += src[i], md += dst[i];
@@ -1224,65 +1242,85 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
     yaw0 = *o.initial_yaw_rad;
     how += "; heading from configuration";
   } else if (tc) {
-    // GNSS positions along the first part of the walk.
-    std::vector<std::pair<GpsTime, Vector3d>> lsq;
-    Vector3d first = Vector3d::Zero();
-    GpsTime stop = samples.back().t;
-    Vector3d prev = p0;
-    for (size_t g = 0; g < in.rover->size(); ++g) {
-      if ((*in.rover)[g].time < samples[s0].t) continue;
-      auto pa = runner.lsq_position(g, prev);
-      if (!pa) continue;
-      prev = *pa;
-      if (lsq.empty()) first = *pa;
-      lsq.push_back({(*in.rover)[g].time, *pa});
-      if (enu_from_ecef(*pa, first).head<2>().norm() >= o.heading_init_distance_m) {
-        stop = (*in.rover)[g].time;
-        break;
-      }
-    }
+    // Pass 1 (docs/fusion.md §8): the INS/ZUPT track with yaw 0 until it has walked D from the start (the walked
+    // distance does not depend on the heading; a GNSS track can "move" D while the person stands, by noise and
+    // blunders), then a 2D fit of that track onto the GNSS epoch solutions over the same span. While the fit's
+    // σ_yaw is above kHeadingInitTargetSigma and the walk goes on, D doubles (at most kHeadingInitDoublings times).
+    constexpr double kHeadingInitTargetSigma = 3.0 * kDegToRad;
+    constexpr int kHeadingInitDoublings = 3;
     EngineOptions ins_only = o;
     ins_only.mode = Mode::kInsOnly;
     ins_only.initial_sigma_yaw_rad = 1e-3;
     ins_only.smoother_enabled = false;
-    EngineResult pass1;
-    PassOptions p1;
-    p1.stop = stop;
-    p1.gnss = false;
-    // Record the INS antenna track at the GNSS epochs by sampling outputs at 20 Hz.
-    ins_only.output_rate_hz = o.mechanization_rate_hz;
-    Runner r1b(in, ins_only, decisions);
-    if (auto ok = r1b.run(s0, ins::nav_state_at_rest(samples[s0].t, p0, level->roll, level->pitch, 0.0), imu0, p1, pass1); !ok) {
-      return make_error("heading initialization pass: " + ok.error().message);
+    ins_only.output_rate_hz = o.mechanization_rate_hz;  // the INS antenna track at the GNSS epochs, sampled at 20 Hz
+    std::vector<std::pair<GpsTime, Vector3d>> lsq;        // GNSS epoch solutions from the start, in time order
+    size_t next_g = 0;
+    Vector3d prev = p0;
+    Vector3d first = Vector3d::Zero();
+    double distance_m = o.heading_init_distance_m, theta = 0.0, rms = 0.0, sigma_yaw = 0.0;
+    size_t n_fit = 0;
+    GpsTime stop;
+    for (int attempt = 0;; ++attempt) {
+      EngineResult pass1;
+      PassOptions p1;
+      p1.gnss = false;
+      p1.stop_displacement_m = distance_m;
+      Runner r1(in, ins_only, decisions);
+      if (auto ok = r1.run(s0, ins::nav_state_at_rest(samples[s0].t, p0, level->roll, level->pitch, 0.0), imu0, p1, pass1);
+          !ok) {
+        return make_error("heading initialization pass: " + ok.error().message);
+      }
+      if (pass1.epochs.empty()) return make_error("heading initialization pass: no output epoch");
+      stop = pass1.epochs.back().t;
+      // Largest horizontal distance of the track from its start (a loop returns near its start).
+      const Vector3d p_beg = pass1.epochs.front().nav.p_eb_e, up = p_beg.normalized();
+      double walked_m = 0.0;
+      for (const auto& e : pass1.epochs) {
+        const Vector3d d = e.nav.p_eb_e - p_beg;
+        walked_m = std::max(walked_m, (d - d.dot(up) * up).norm());
+      }
+      for (; next_g < in.rover->size() && (*in.rover)[next_g].time <= stop; ++next_g) {
+        if ((*in.rover)[next_g].time < samples[s0].t) continue;
+        auto pa = runner.lsq_position(next_g, prev);
+        if (!pa) continue;
+        prev = *pa;
+        if (lsq.empty()) first = *pa;
+        lsq.push_back({(*in.rover)[next_g].time, *pa});
+      }
+      std::vector<Vector3d> src, dst;
+      size_t k = 0;
+      for (const auto& [t, pa] : lsq) {
+        while (k + 1 < pass1.epochs.size() && pass1.epochs[k + 1].t <= t) ++k;
+        if (k >= pass1.epochs.size() || std::abs(pass1.epochs[k].t - t) > 0.06) continue;
+        const Vector3d p_imu = pass1.epochs[k].nav.p_eb_e;
+        src.push_back(enu_from_ecef(p_imu + runner.lever_e(p_imu), first));
+        dst.push_back(enu_from_ecef(pa, first));
+      }
+      if (src.size() < 5 || walked_m < 10.0) {
+        return make_error(fmt_message("cannot find the initial heading from motion: the INS/ZUPT track goes %.1f m from its start "
+                                      "(at least 10 m with 5 GNSS epoch solutions needed); set initial.yaw_deg",
+                                      walked_m));
+      }
+      std::tie(theta, rms) = fit_yaw(src, dst);
+      double spread2 = 0;
+      Vector3d mean = Vector3d::Zero();
+      for (const auto& p : src) mean += p;
+      mean /= static_cast<double>(src.size());
+      for (const auto& p : src) spread2 += (p - mean).head<2>().squaredNorm();
+      sigma_yaw = std::clamp(2.0 * rms / std::sqrt(std::max(spread2, 1.0)), 1.0 * kDegToRad, 30.0 * kDegToRad);
+      n_fit = src.size();
+      const bool walk_goes_on = walked_m >= distance_m && stop < samples.back().t;
+      if (sigma_yaw <= kHeadingInitTargetSigma || !walk_goes_on || attempt == kHeadingInitDoublings) break;
+      distance_m *= 2.0;
     }
-    std::vector<Vector3d> src, dst;
-    size_t k = 0;
-    for (const auto& [t, pa] : lsq) {
-      while (k + 1 < pass1.epochs.size() && pass1.epochs[k + 1].t <= t) ++k;
-      if (k >= pass1.epochs.size() || std::abs(pass1.epochs[k].t - t) > 0.06) continue;
-      const Vector3d p_imu = pass1.epochs[k].nav.p_eb_e;
-      src.push_back(enu_from_ecef(p_imu + runner.lever_e(p_imu), first));
-      dst.push_back(enu_from_ecef(pa, first));
-    }
-    if (src.size() < 5 || (dst.back() - dst.front()).head<2>().norm() < 10.0) {
-      return make_error("cannot find the initial heading from motion: the GNSS track moves less than 10 m; set initial.yaw_deg");
-    }
-    auto [theta, rms] = fit_yaw(src, dst);
     yaw0 = wrap_pi(-theta);  // ENU rotation counter-clockwise by theta = heading change of -theta
-    double spread2 = 0;
-    Vector3d mean = Vector3d::Zero();
-    for (const auto& p : src) mean += p;
-    mean /= static_cast<double>(src.size());
-    for (const auto& p : src) spread2 += (p - mean).head<2>().squaredNorm();
-    const double sigma_yaw = std::clamp(2.0 * rms / std::sqrt(std::max(spread2, 1.0)), 1.0 * kDegToRad, 30.0 * kDegToRad);
     opt.initial_sigma_yaw_rad = sigma_yaw;
     sum.heading_fit_rms_m = rms;
-    char buf[200];
-    std::snprintf(buf, sizeof buf,
-                  "; heading from motion: INS/ZUPT track fitted to %zu GNSS epoch solutions until %s (fit RMS %.2f m, "
-                  "yaw sigma %.1f deg)",
-                  src.size(), stop.to_string().c_str(), rms, sigma_yaw * kRadToDeg);
-    how += buf;
+    sum.heading_init_end = stop;
+    sum.heading_init_distance_m = distance_m;
+    how += fmt_message("; heading from motion: INS/ZUPT track (%.0f m walked) fitted to %zu GNSS epoch solutions until "
+                       "%s (fit RMS %.2f m, yaw sigma %.1f deg)",
+                       distance_m, n_fit, stop.to_string().c_str(), rms, sigma_yaw * kRadToDeg);
   } else {
     return make_error("mode ins needs an initial heading (initial.yaw_deg)");
   }

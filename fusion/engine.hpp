@@ -132,6 +132,8 @@ struct EngineSummary {
   std::map<std::string, long> doppler_used_rejected;
   std::string initialization;        ///< how the state was initialized and when
   double heading_fit_rms_m = 0.0;
+  std::optional<GpsTime> heading_init_end;  ///< end of the heading-from-motion span (tc without a configured yaw)
+  double heading_init_distance_m = 0.0;     ///< distance the INS/ZUPT track walked for it [m] (docs/fusion.md §8)
   double initial_yaw_deg = 0.0;
   bool covariance_healthy = true;    ///< false once a health check failed (even if re-initialized afterwards)
   std::string health_message;

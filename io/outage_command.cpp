@@ -151,19 +151,8 @@ nlohmann::ordered_json figures_json(const OutageFigures& f) {
 // A window's run as solution.csv rows (the columns of pednav run; position of the IMU).
 std::vector<SolutionRow> solution_rows(const std::vector<fusion::EpochOutput>& epochs) {
   std::vector<SolutionRow> rows;
-  for (const auto& e : epochs) {
-    SolutionRow r;
-    r.time = e.t;
-    r.p_e = e.nav.p_eb_e;
-    const Geodetic llh = geodetic_from_ecef(e.nav.p_eb_e);
-    r.v_n = R_e_n(llh.lat, llh.lon).transpose() * e.nav.v_eb_e;
-    r.cov_p_n = e.cov_p_n;
-    r.sd_yaw_deg = e.sd_yaw_rad * kRadToDeg;
-    r.n_sats_used = e.n_sats_used;
-    r.n_sats_rejected = e.n_sats_rejected;
-    r.zupt = e.zupt;
-    rows.push_back(r);
-  }
+  rows.reserve(epochs.size());
+  for (const auto& e : epochs) rows.push_back(solution_row(e));
   return rows;
 }
 
@@ -201,32 +190,24 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
   if (!nominal) return make_error(c.source_file + ": " + nominal.error().message);
   res.has_smoothed = nominal->summary.smoothed;
   if (a.start_tow_s.empty()) {
-    // Converged: the heading initialization is over (the run has walked heading_init_distance_m: a window
+    // Converged: the heading initialization is over (the epochs after the span the heading was fitted on: a window
     // overlapping it would change the initialization itself, since the mask also applies to the epoch solutions
     // the heading is fitted to) and the horizontal and yaw sigmas are below the thresholds.
-    const double init_distance_m = d.options.initial_yaw_rad ? 0.0 : d.options.heading_init_distance_m;
+    const std::optional<GpsTime> init_end = nominal->summary.heading_init_end;
     std::optional<GpsTime> converged;
-    double walked_m = 0.0;
-    for (size_t i = 0; i < nominal->epochs.size(); ++i) {
-      const auto& e = nominal->epochs[i];
-      if (i > 0) {
-        const Eigen::Vector3d d_e = e.nav.p_eb_e - nominal->epochs[i - 1].nav.p_eb_e;
-        const Geodetic llh = geodetic_from_ecef(e.nav.p_eb_e);
-        const Eigen::Vector3d d_n = R_e_n(llh.lat, llh.lon).transpose() * d_e;
-        walked_m += std::hypot(d_n.x(), d_n.y());
-      }
+    for (const auto& e : nominal->epochs) {
       const double sd_h = std::sqrt(std::max(0.0, e.cov_p_n(0, 0) + e.cov_p_n(1, 1)));
-      if (walked_m >= init_distance_m && sd_h <= a.converged_sigma_horizontal_m &&
+      if ((!init_end || e.t > *init_end) && sd_h <= a.converged_sigma_horizontal_m &&
           e.sd_yaw_rad * kRadToDeg <= a.converged_sigma_yaw_deg) {
         converged = e.t;
         break;
       }
     }
     if (!converged) {
-      return make_error(fmt::format("{}: the run without outage never converged (walked {} m, horizontal sigma <= {} m "
-                                    "and yaw sigma <= {} deg); lower the thresholds with --converged-sigma-m/--converged-yaw-deg "
-                                    "or give --starts",
-                                    c.source_file, init_distance_m, a.converged_sigma_horizontal_m,
+      return make_error(fmt::format("{}: the run without outage never converged (after the heading initialization, "
+                                    "horizontal sigma <= {} m and yaw sigma <= {} deg); lower the thresholds with "
+                                    "--converged-sigma-m/--converged-yaw-deg or give --starts",
+                                    c.source_file, a.converged_sigma_horizontal_m,
                                     a.converged_sigma_yaw_deg));
     }
     spdlog::info("converged at {} (+{:.0f} s settle)", converged->to_string(), a.settle_s);

@@ -30,22 +30,6 @@ gnss::System system_of(const std::string& letter) {
   return gnss::System::kGps;
 }
 
-SolutionRow to_row(const fusion::EpochOutput& e) {
-  SolutionRow r;
-  r.time = e.t;
-  r.p_e = e.nav.p_eb_e;
-  const Geodetic llh = geodetic_from_ecef(e.nav.p_eb_e);
-  const Eigen::Matrix3d Ren = R_e_n(llh.lat, llh.lon);
-  r.v_n = Ren.transpose() * e.nav.v_eb_e;
-  r.rpy_deg = euler_from_R_n_b(Ren.transpose() * e.nav.R_e_b()) * kRadToDeg;
-  r.cov_p_n = e.cov_p_n;
-  r.sd_yaw_deg = e.sd_yaw_rad * kRadToDeg;
-  r.n_sats_used = e.n_sats_used;
-  r.n_sats_rejected = e.n_sats_rejected;
-  r.zupt = e.zupt;
-  r.pos_quality = e.n_sats_used > 0 ? 4 : 5;
-  return r;
-}
 
 // read = used + rejected (by reason) + skipped (by reason), for IMU rows and rover measurements (docs/robustness.md).
 nlohmann::ordered_json accounting_json(const ImuLog& imu, const RunInputs& data, const fusion::EngineSummary& sum, bool tc) {
@@ -79,6 +63,23 @@ nlohmann::ordered_json accounting_json(const ImuLog& imu, const RunInputs& data,
 }
 
 }  // namespace
+
+SolutionRow solution_row(const fusion::EpochOutput& e) {
+  SolutionRow r;
+  r.time = e.t;
+  r.p_e = e.nav.p_eb_e;
+  const Geodetic llh = geodetic_from_ecef(e.nav.p_eb_e);
+  const Eigen::Matrix3d Ren = R_e_n(llh.lat, llh.lon);
+  r.v_n = Ren.transpose() * e.nav.v_eb_e;
+  r.rpy_deg = euler_from_R_n_b(Ren.transpose() * e.nav.R_e_b()) * kRadToDeg;
+  r.cov_p_n = e.cov_p_n;
+  r.sd_yaw_deg = e.sd_yaw_rad * kRadToDeg;
+  r.n_sats_used = e.n_sats_used;
+  r.n_sats_rejected = e.n_sats_rejected;
+  r.zupt = e.zupt;
+  r.pos_quality = e.n_sats_used > 0 ? 4 : 5;
+  return r;
+}
 
 fusion::EngineOptions engine_options(const RunConfig& c) {
   fusion::EngineOptions o;
@@ -218,7 +219,7 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
   const std::filesystem::path out(out_dir);
   std::vector<SolutionRow> rows;
   rows.reserve(res->epochs.size());
-  for (const auto& e : res->epochs) rows.push_back(to_row(e));
+  for (const auto& e : res->epochs) rows.push_back(solution_row(e));
   if (auto ok = write_solution_csv((out / "solution.csv").string(), rows); !ok) return ok.error();
   if (auto ok = write_solution_pos((out / "solution.pos").string(), rows,
                                    {"pednav run (" + c.mode + ", forward filter, IMU position)", c.source_file});
@@ -231,7 +232,7 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
   }
   std::vector<SolutionRow> smoothed_rows;
   smoothed_rows.reserve(res->smoothed.size());
-  for (const auto& e : res->smoothed) smoothed_rows.push_back(to_row(e));
+  for (const auto& e : res->smoothed) smoothed_rows.push_back(solution_row(e));
   if (!sum.smoother_message.empty()) spdlog::warn("{} (only the forward solution is written)", sum.smoother_message);
   if (sum.smoothed) {
     if (auto ok = write_solution_csv((out / "smoothed.csv").string(), smoothed_rows); !ok) return ok.error();
@@ -247,6 +248,10 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
   j["initialization"] = sum.initialization;
   j["initial_yaw_deg"] = sum.initial_yaw_deg;
   j["heading_fit_rms_m"] = sum.heading_fit_rms_m;
+  if (sum.heading_init_end) {
+    j["heading_init_distance_m"] = sum.heading_init_distance_m;
+    j["heading_init_end_gps_tow_s"] = sum.heading_init_end->tow_s();
+  }
   j["output_epochs"] = res->epochs.size();
   j["imu"] = {{"file", c.imu.file},
               {"rows", imu->report.rows},

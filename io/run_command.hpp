@@ -11,6 +11,7 @@
 #include "gnss/types.hpp"
 #include "io/config.hpp"
 #include "io/imu_csv.hpp"
+#include "io/solution_writer.hpp"
 
 namespace pednav::io {
 
@@ -32,6 +33,10 @@ struct RunInputs {
 Expected<RunInputs> load_run_inputs(const RunConfig& config);
 
 /// Run `pednav run` for a loaded configuration and write the outputs into out_dir (created).
+/// One solution.csv / smoothed.csv row of an output epoch (IMU position, NED velocity, attitude, σ; pos quality 4
+/// with satellites used, else 5).
+SolutionRow solution_row(const fusion::EpochOutput& e);
+
 Expected<fusion::EngineSummary> run_run_command(const RunConfig& config, const std::string& out_dir);
 
 }  // namespace pednav::io
