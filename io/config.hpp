@@ -120,7 +120,7 @@ struct ClockConfig {
 
 /// `multipath:` section: code-multipath Gauss-Markov states of the tc filter (docs/consistency.md §3).
 struct MultipathConfig {
-  bool states = false;              ///< one unit-variance GM state per tracked satellite
+  bool states = true;               ///< one unit-variance GM state per tracked satellite (tc; default on since session 4)
   double sigma_m = 0.28;            ///< multipath σ at C/N0 >= cn0_ref_dbhz [m] (per receiver)
   double tau_s = 20.0;              ///< correlation time [s]
   double cn0_ref_dbhz = 45.0;       ///< below, σ grows as 10^((ref − C/N0)/20)
@@ -130,7 +130,7 @@ struct MultipathConfig {
 
 /// `scale_factors:` section: IMU scale-factor states (the spec's *_scale_sigma, docs/consistency.md §3).
 struct ScaleFactorConfig {
-  bool states = false;
+  bool states = false;  ///< off: in ins mode they degrade INS/ZUPT (docs/consistency.md §3)
 };
 
 /// `output:` section.

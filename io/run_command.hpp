@@ -32,11 +32,11 @@ struct RunInputs {
 /// Read what a `pednav run` (or an outage study) of this configuration needs; errors name the file and key.
 Expected<RunInputs> load_run_inputs(const RunConfig& config);
 
-/// Run `pednav run` for a loaded configuration and write the outputs into out_dir (created).
 /// One solution.csv / smoothed.csv row of an output epoch (IMU position, NED velocity, attitude, σ; pos quality 4
 /// with satellites used, else 5).
 SolutionRow solution_row(const fusion::EpochOutput& e);
 
+/// Run `pednav run` for a loaded configuration and write the outputs into out_dir (created).
 Expected<fusion::EngineSummary> run_run_command(const RunConfig& config, const std::string& out_dir);
 
 }  // namespace pednav::io
