@@ -46,6 +46,7 @@ struct McOptions {
   bool step_velocity = false;      ///< seed 000 step-velocity aiding
   double leg_length_m = fusion::StepVelocityOptions{}.leg_length_m;
   bool multipath_states = false;   ///< filter multipath GM states with the scenario's multipath model
+  bool white_code = false;         ///< no multipath states (white code errors in R, the default before session 4)
   bool scale_states = false;       ///< filter scale-factor states (the scenario's IMU spec)
 };
 
@@ -119,6 +120,7 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
     o.multipath_tau_s = sc.gnss.multipath_tau_s;
     o.multipath_cn0_ref_dbhz = sc.gnss.multipath_cn0_ref_dbhz;
   }
+  if (mo.white_code) o.multipath_sigma_m = 0.0;
   o.zupt_updates = mo.zupt_updates;
   o.step_velocity.enabled = mo.step_velocity;
   o.step_velocity.leg_length_m = mo.leg_length_m;
@@ -404,6 +406,9 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
   cmd->add_flag("!--no-zupt-updates", mo->zupt_updates, "The ZUPT detector only segments steps (no ZUPT updates)");
   cmd->add_flag("--multipath-states", mo->multipath_states,
                 "Filter code-multipath Gauss-Markov states with the scenario's multipath sigma/tau/C/N0 reference");
+  cmd->add_flag("--white-code", mo->white_code,
+                "No multipath states (white code errors; `multipath: {states: false}` of pednav run)")
+      ->excludes("--multipath-states");
   cmd->add_flag("--scale-states", mo->scale_states, "Filter gyro/accelerometer scale-factor states");
   cmd->add_flag("--step-velocity", mo->step_velocity, "Seed 000 step-averaged velocity aiding");
   cmd->add_option("--leg-length-m", mo->leg_length_m, "Inverted-pendulum length l of the step-length model [m]")
