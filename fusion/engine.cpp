@@ -419,9 +419,10 @@ double median(std::vector<double>& v) {
 struct PassOptions {
   bool gnss = true;
   std::optional<GpsTime> stop;
-  /// Stop after the first mechanization epoch whose IMU position is this far (horizontally) from the start
-  /// (the heading pass: the distance walked does not depend on the unknown heading). Output of that epoch included.
-  std::optional<double> stop_displacement_m;
+  /// Stop once the IMU has walked this far: horizontal path length of the nominal position over the samples the
+  /// detector does not flag as stance (ZUPT corrections at rest do not count). The heading pass: the distance walked
+  /// does not depend on the unknown heading.
+  std::optional<double> stop_walked_m;
 };
 
 class Runner {
@@ -608,16 +609,21 @@ class Runner {
       if (in_.on_step) in_.on_step(inc.t1);
     };
 
-    const Vector3d p_start_e = nav0.p_eb_e;
-    const Vector3d up_start_e = p_start_e.normalized();
-    auto displaced = [&] {
-      const Vector3d d = f.x().nav.p_eb_e - p_start_e;
-      return (d - d.dot(up_start_e) * up_start_e).norm() >= *po.stop_displacement_m;
+    const Vector3d up_start_e = nav0.p_eb_e.normalized();
+    Vector3d p_last_e = nav0.p_eb_e;
+    double walked_m = 0.0;
+    auto walked_enough = [&] {
+      const Vector3d d = f.x().nav.p_eb_e - p_last_e;
+      p_last_e = f.x().nav.p_eb_e;
+      if (!decisions_[std::min(sample_index, decisions_.size() - 1)].stance) {
+        walked_m += (d - d.dot(up_start_e) * up_start_e).norm();
+      }
+      return walked_m >= *po.stop_walked_m;
     };
     for (; sample_index < samples.size(); ++sample_index) {
       const ins::ImuSample& raw = samples[sample_index];
       if (po.stop && raw.t > *po.stop) break;
-      if (po.stop_displacement_m && displaced()) break;
+      if (po.stop_walked_m && walked_enough()) break;
       if (!raw.omega_ib_b.allFinite() || !raw.f_ib_b.allFinite()) {
         count(sum.imu_rejected, "non_finite");
         continue;
@@ -1244,10 +1250,11 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
   } else if (tc) {
     // Pass 1 (docs/fusion.md §8): the INS/ZUPT track with yaw 0 until it has walked D from the start (the walked
     // distance does not depend on the heading; a GNSS track can "move" D while the person stands, by noise and
-    // blunders), then a 2D fit of that track onto the GNSS epoch solutions over the same span. While the fit's
-    // σ_yaw is above kHeadingInitTargetSigma and the walk goes on, D doubles (at most kHeadingInitDoublings times).
+    // blunders), then a 2D fit of that track onto the GNSS epoch solutions over the same span. While the track is
+    // less than 10 m from its start or the fit's σ_yaw is above kHeadingInitTargetSigma, and the walk goes on, D
+    // doubles (at most kHeadingInitDoublings times).
     constexpr double kHeadingInitTargetSigma = 3.0 * kDegToRad;
-    constexpr int kHeadingInitDoublings = 3;
+    constexpr int kHeadingInitDoublings = 5;  // up to 32 D
     EngineOptions ins_only = o;
     ins_only.mode = Mode::kInsOnly;
     ins_only.initial_sigma_yaw_rad = 1e-3;
@@ -1264,7 +1271,7 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
       EngineResult pass1;
       PassOptions p1;
       p1.gnss = false;
-      p1.stop_displacement_m = distance_m;
+      p1.stop_walked_m = distance_m;
       Runner r1(in, ins_only, decisions);
       if (auto ok = r1.run(s0, ins::nav_state_at_rest(samples[s0].t, p0, level->roll, level->pitch, 0.0), imu0, p1, pass1);
           !ok) {
@@ -1272,12 +1279,12 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
       }
       if (pass1.epochs.empty()) return make_error("heading initialization pass: no output epoch");
       stop = pass1.epochs.back().t;
-      // Largest horizontal distance of the track from its start (a loop returns near its start).
+      // Largest horizontal distance of the track from its start (the fit needs extent; a loop returns near its start).
       const Vector3d p_beg = pass1.epochs.front().nav.p_eb_e, up = p_beg.normalized();
-      double walked_m = 0.0;
+      double extent_m = 0.0;
       for (const auto& e : pass1.epochs) {
         const Vector3d d = e.nav.p_eb_e - p_beg;
-        walked_m = std::max(walked_m, (d - d.dot(up) * up).norm());
+        extent_m = std::max(extent_m, (d - d.dot(up) * up).norm());
       }
       for (; next_g < in.rover->size() && (*in.rover)[next_g].time <= stop; ++next_g) {
         if ((*in.rover)[next_g].time < samples[s0].t) continue;
@@ -1296,10 +1303,15 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
         src.push_back(enu_from_ecef(p_imu + runner.lever_e(p_imu), first));
         dst.push_back(enu_from_ecef(pa, first));
       }
-      if (src.size() < 5 || walked_m < 10.0) {
+      const bool walk_goes_on = stop < samples.back().t;  // pass 1 stopped at the distance, not at the end of data
+      if (src.size() < 5 || extent_m < 10.0) {
+        if (walk_goes_on && attempt < kHeadingInitDoublings) {  // e.g. shuffling on the spot before the walk
+          distance_m *= 2.0;
+          continue;
+        }
         return make_error(fmt_message("cannot find the initial heading from motion: the INS/ZUPT track goes %.1f m from its start "
                                       "(at least 10 m with 5 GNSS epoch solutions needed); set initial.yaw_deg",
-                                      walked_m));
+                                      extent_m));
       }
       std::tie(theta, rms) = fit_yaw(src, dst);
       double spread2 = 0;
@@ -1309,7 +1321,6 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
       for (const auto& p : src) spread2 += (p - mean).head<2>().squaredNorm();
       sigma_yaw = std::clamp(2.0 * rms / std::sqrt(std::max(spread2, 1.0)), 1.0 * kDegToRad, 30.0 * kDegToRad);
       n_fit = src.size();
-      const bool walk_goes_on = walked_m >= distance_m && stop < samples.back().t;
       if (sigma_yaw <= kHeadingInitTargetSigma || !walk_goes_on || attempt == kHeadingInitDoublings) break;
       distance_m *= 2.0;
     }
