@@ -123,8 +123,16 @@ void RtsInterval::update(const MatH& H, const VecR& r, const Ldlt& S_ldlt, const
                                    MatH::MaxRowsAtCompileTime>;
   using RowsMatrix = Eigen::Matrix<double, MatH::RowsAtCompileTime, Eigen::Dynamic, Eigen::ColMajor,
                                    MatH::MaxRowsAtCompileTime, ins::kMaxErrorDim>;
+  // L = C Hᵀ = Cov(δx_a, y | Y) (the measurement sees δx_a only through δx_j), as sums of whole columns of C over
+  // the non-zeros of H (ZUPT + ZARU: 12 of 6 x 17): L.col(i) += H(i, j) C.col(j).
   ColsMatrix L;
-  L.noalias() = C_ * H.transpose();            // Cov(δx_a, y | Y): the measurement sees δx_a only through δx_j
+  L.setZero(C_.rows(), H.rows());
+  for (int j = 0; j < H.cols(); ++j) {
+    for (int i = 0; i < H.rows(); ++i) {
+      const double h = H(i, j);
+      if (h != 0.0) L.col(i) += h * C_.col(j);
+    }
+  }
   const RowsMatrix W = S_ldlt.solve(L.transpose());  // S⁻¹ Lᵀ
   m_.noalias() += W.transpose() * r;           // eq. 12.16
   Sigma_.noalias() -= L * W;                   // eq. 12.16
