@@ -248,8 +248,8 @@ void BM_SmootherStep(benchmark::State& st) {
 BENCHMARK(BM_SmootherStep);
 
 // The smoother's bookkeeping of one stance step as the engine does it since the interval recursion (docs/fusion.md
-// eqs. 12.15-12.17): the cross-covariance prediction C Φᵀ with Φ of the INS error model by its non-zeros, and the
-// ZUPT form D + ZARU update (6 rows, the filter's S factorization and gain); the interval is closed (M = C P⁻¹,
+// eqs. 12.15-12.17): the cross-covariance prediction Γ Φᵀ with Φ of the INS error model by its non-zeros, and the
+// ZUPT form D + ZARU update (6 rows, the filter's S factorization and gain); the interval is closed (M = Γ P⁻¹,
 // eq. 12.20) and restarted every 20 iterations (1 Hz output at 20 Hz). Per iteration the counterpart of
 // BM_SmootherStep (which the earlier engine ran at every stance step).
 void BM_SmootherIntervalStep(benchmark::State& st) {

@@ -186,7 +186,7 @@ class Filter {
       }
     }
     Phi_sparse_.assign(m.Phi);
-    // Smoother: the cross-covariance of the error at the last output epoch with the current error, C ← C Φᵀ
+    // Smoother: the cross-covariance of the error at the last output epoch with the current error, Γ ← Γ Φᵀ
     // (docs/fusion.md eq. 12.15).
     if (recording_) interval_.predict(Phi_sparse_);
     covariance_predict(P_, Phi_sparse_, m.Qd, tmp_);
@@ -201,9 +201,10 @@ class Filter {
     // Smoother: the estimate of the error at the last output epoch, its variance and its cross-covariance with the
     // current error are conditioned on the same measurement, with the filter's S and K (docs/fusion.md eqs.
     // 12.16-12.17).
-    const bool ok = recording_ ? joseph_update(P_, H, r, R, dx, tmp_,
-                                               [&](const auto& S_ldlt, const auto& K) { interval_.update(H, r, S_ldlt, K); })
-                               : joseph_update(P_, H, r, R, dx, tmp_);
+    const bool ok = recording_
+                        ? joseph_update(P_, H, r, R, dx, tmp_,
+                                        [&](const auto& S_ldlt, const auto& K) { interval_.update(H, r, S_ldlt, K); })
+                        : joseph_update(P_, H, r, R, dx, tmp_);
     if (!ok) return false;
     apply(dx);
     return true;
@@ -263,7 +264,7 @@ class Filter {
     P_.middleCols<3>(v) += APa.transpose();
     P_.block<3, 3>(v, v) += APaaAt;
     P_ = 0.5 * (P_ + P_.transpose()).eval();
-    // The smoother's cross-covariance follows the coordinate change: C ← C Jᵀ (docs/fusion.md eq. 12.18).
+    // The smoother's cross-covariance follows the coordinate change: Γ ← Γ Jᵀ (docs/fusion.md eq. 12.18).
     if (recording_) interval_.reexpress(v, a, A);
   }
 

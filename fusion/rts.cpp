@@ -69,56 +69,59 @@ RtsSegment RtsAccumulator::take() {
 
 void RtsInterval::restart(const ErrorMatrix& P_a) {
   // At a the error is δx_a itself: Cov(δx_a, δx_a) = Var(δx_a | Y_a) = P_a|a, E[δx_a | Y_a] = 0 (eq. 12.14).
-  C_ = P_a;
-  Sigma_ = P_a;
-  m_.setZero(P_a.rows());
+  Gamma_ = P_a;
+  V_ = P_a;
+  mu_.setZero(P_a.rows());
   steps_ = 0;
 }
 
 void RtsInterval::predict(const ColumnSparse<ins::kMaxErrorDim>& Phi) {
-  // C ← C Φᵀ as sums of whole columns, (C Φᵀ).col(r) += Φ_rc C.col(c), as the filter's P Φᵀ (eq. 12.15).
-  tmp_.setZero(C_.rows(), C_.cols());
-  Phi.add_times_transposed(C_, tmp_);
-  C_ = tmp_;
+  // Γ ← Γ Φᵀ as sums of whole columns, (Γ Φᵀ).col(r) += Φ_rc Γ.col(c), as the filter's P Φᵀ (eq. 12.15).
+  tmp_.setZero(Gamma_.rows(), Gamma_.cols());
+  Phi.add_times_transposed(Gamma_, tmp_);
+  Gamma_ = tmp_;
   ++steps_;
 }
 
 void RtsInterval::predict(const ErrorMatrix& Phi) {
-  tmp_.noalias() = C_ * Phi.transpose();
-  C_ = tmp_;
+  tmp_.noalias() = Gamma_ * Phi.transpose();
+  Gamma_ = tmp_;
   ++steps_;
 }
 
 void RtsInterval::reexpress(int dst, int src, const Eigen::Matrix3d& B) {
-  // C Jᵀ = C + C E_src Bᵀ E_dstᵀ: only the dst columns change (the blocks are disjoint, no aliasing; eq. 12.18).
-  C_.middleCols<3>(dst).noalias() += C_.middleCols<3>(src) * B.transpose();
+  // Γ Jᵀ = Γ + Γ E_src Bᵀ E_dstᵀ: only the dst columns change (the blocks are disjoint, no aliasing; eq. 12.18).
+  Gamma_.middleCols<3>(dst).noalias() += Gamma_.middleCols<3>(src) * B.transpose();
 }
 
 void RtsInterval::reexpress(const ErrorMatrix& J) {
-  tmp_.noalias() = C_ * J.transpose();
-  C_ = tmp_;
+  tmp_.noalias() = Gamma_ * J.transpose();
+  Gamma_ = tmp_;
 }
 
-void RtsInterval::restart_state(int i) { C_.col(i).setZero(); }  // eq. 12.19
+// A fresh variable is uncorrelated with δx_a (eq. 12.19).
+void RtsInterval::restart_state(int i) {
+  Gamma_.col(i).setZero();
+}
 
 void RtsInterval::close(const ErrorMatrix& P_b, RtsSegment& out) const {
-  const int n = static_cast<int>(C_.rows());
+  const int n = static_cast<int>(Gamma_.rows());
   if (steps_ == 0) {  // b = a: the identity map (what the per-step composition gives for no steps)
     out.M.setIdentity(n, n);
     out.m.setZero(n);
     out.S.setZero(n, n);
     return;
   }
-  // M = C P_b|b⁻¹ from P_b|b Mᵀ = Cᵀ (eq. 12.20), Jacobi-scaled as in rts_step (metres, radians and clock variances
-  // up to 1e12 m² in one matrix): D = diag(P_b|b)^(-1/2), (D P D)(D⁻¹ Mᵀ) = D Cᵀ.
+  // M = Γ P_b|b⁻¹ from P_b|b Mᵀ = Γᵀ (eq. 12.20), Jacobi-scaled as in rts_step (metres, radians and clock variances
+  // up to 1e12 m² in one matrix): D = diag(P_b|b)^(-1/2), (D P D)(D⁻¹ Mᵀ) = D Γᵀ.
   const ErrorVector D = P_b.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
   const ErrorMatrix scaled = D.asDiagonal() * P_b * D.asDiagonal();
   const Eigen::LDLT<ErrorMatrix> ldlt(scaled);
-  const ErrorMatrix Mt = D.asDiagonal() * ldlt.solve(D.asDiagonal() * C_.transpose());
+  const ErrorMatrix Mt = D.asDiagonal() * ldlt.solve(D.asDiagonal() * Gamma_.transpose());
   out.M = Mt.transpose();
-  out.m = m_;
-  out.S = Sigma_;  // S = Var(δx_a | δx_b, Y_b) = Σ − M Cᵀ (eq. 12.20)
-  out.S.noalias() -= out.M * C_.transpose();
+  out.m = mu_;
+  out.S = V_;  // S = Var(δx_a | δx_b, Y_b) = V − M Γᵀ (eq. 12.20)
+  out.S.noalias() -= out.M * Gamma_.transpose();
   out.S = 0.5 * (out.S + out.S.transpose()).eval();
 }
 
