@@ -1,5 +1,6 @@
 // Benchmarks of the fusion hot paths (issue 10): covariance prediction of one mechanization step, a ZUPT (+ZARU)
-// update, an SD pseudorange + Doppler update with 10 satellites, one smoother step, and reading a RINEX
+// update, an SD pseudorange + Doppler update with 10 satellites, one smoother step (the earlier per-step backward
+// map, and the interval bookkeeping the engine runs now), and reading a RINEX
 // observation file (epochs per second). Error state n = 17 (15 INS + one clock + drift, as `pednav run` with GPS).
 // Every benchmark also reports `allocs_per_iter`, the heap allocations per iteration counted by a replaced
 // global operator new (docs/performance.md "Heap allocations").
@@ -14,6 +15,7 @@
 #include <random>
 #include <string>
 
+#include "core/column_sparse.hpp"
 #include "core/geodesy.hpp"
 #include "fusion/engine.hpp"
 #include "fusion/kalman.hpp"
@@ -244,6 +246,58 @@ void BM_SmootherStep(benchmark::State& st) {
   allocs.report(st);
 }
 BENCHMARK(BM_SmootherStep);
+
+// The smoother's bookkeeping of one stance step as the engine does it since the interval recursion (docs/fusion.md
+// eqs. 12.15-12.17): the cross-covariance prediction Γ Φᵀ with Φ of the INS error model by its non-zeros, and the
+// ZUPT form D + ZARU update (6 rows, the filter's S factorization and gain); the interval is closed (M = Γ P⁻¹,
+// eq. 12.20) and restarted every 20 iterations (1 Hz output at 20 Hz). Per iteration the counterpart of
+// BM_SmootherStep (which the earlier engine ran at every stance step).
+void BM_SmootherIntervalStep(benchmark::State& st) {
+  const ins::ErrorStateLayout layout = layout17();
+  const int n = layout.dim();
+  const auto spec = *ins::imu_spec_preset("crista");
+  const ins::NavState a = ins::nav_state_at_rest(GpsTime(), ecef_from_geodetic({0.9, -2.0, 1000.0}), 0.1, 0.2, 0.3);
+  const ins::ImuIncrement inc = increment();
+  const ins::NavState b = ins::mechanize(a, inc);
+  const ins::DiscreteErrorModel model = ins::interval_error_model(layout, spec, a, b, inc);
+  ColumnSparse<ins::kMaxErrorDim> Phi;
+  Phi.assign(model.Phi);
+  const ErrorMatrix P = random_spd(n, 4u);
+  using H6 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, ins::kMaxErrorDim>;
+  using R6 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, 6>;
+  using V6 = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 6, 1>;
+  using K6 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, ins::kMaxErrorDim, 6>;
+  const Eigen::Vector3d v(0.01, -0.02, 0.005);
+  H6 H = H6::Zero(6, n);
+  const Eigen::Matrix<double, 3, 6> J = fusion::zupt_jacobian(v, fusion::ZuptForm::kDynamic);
+  H.block<3, 3>(0, ins::kVel.offset) = J.leftCols<3>();
+  H.block<3, 3>(0, ins::kAtt.offset) = J.rightCols<3>();
+  H.block<3, 3>(3, ins::kBiasGyro.offset).setIdentity();
+  V6 r(6);
+  r << -v, 1e-4, -2e-4, 5e-5;
+  R6 S = R6::Zero(6, 6);
+  S.diagonal() << 4e-4, 4e-4, 4e-4, 1e-4, 1e-4, 1e-4;
+  S.noalias() += H * P * H.transpose();
+  const Eigen::LDLT<R6> ldlt(S);
+  const K6 K = ldlt.solve(H * P).transpose();
+  fusion::RtsInterval interval(n);
+  interval.restart(P);
+  fusion::RtsSegment seg;
+  int k = 0;
+  AllocCounter allocs;
+  for (auto _ : st) {
+    interval.predict(Phi);
+    interval.update(H, r, ldlt, K);
+    if (++k == 20) {
+      interval.close(P, seg);
+      interval.restart(P);
+      k = 0;
+      benchmark::DoNotOptimize(seg.M.data());
+    }
+  }
+  allocs.report(st);
+}
+BENCHMARK(BM_SmootherIntervalStep);
 
 // Reading a RINEX 3.04 observation file (1 Hz, 10 GPS satellites with C1C/D1C/S1C) through the RTKLIB adapter:
 // items/s = epochs per second.

@@ -145,6 +145,7 @@ class Filter {
       mp_value_[i] = 0.0;
       mp_last_ns_[i] = kNeverNs;
     }
+    interval_.restart(P_);  // sized; the smoother's bookkeeping starts at the first output epoch (smoother_restart)
   }
 
   // Replace the variance of a 3-state block (position [m], velocity [m/s]) by sigma² per axis, uncorrelated
@@ -185,35 +186,11 @@ class Filter {
       }
     }
     Phi_sparse_.assign(m.Phi);
-    if (recording_) {
-      // A run of steps without updates is one smoother step with the product of the transitions (docs/fusion.md
-      // eq. 12.13): keep the posterior at the run's start and compose Φ.
-      if (!run_open_) {
-        P_post_prev_ = P_;
-        PhiT_ = m.Phi.transpose();
-        run_open_ = true;
-        run_steps_ = 1;
-      } else {
-        // Φ_run ← Φ Φ_run, kept transposed so that the product is a sum of columns: Φ_runᵀ ← Φ_runᵀ Φᵀ.
-        tmp_.setZero(PhiT_.rows(), PhiT_.cols());
-        Phi_sparse_.add_times_transposed(PhiT_, tmp_);
-        PhiT_ = tmp_;
-        ++run_steps_;
-      }
-    }
+    // Smoother: the cross-covariance of the error at the last output epoch with the current error, Γ ← Γ Φᵀ
+    // (docs/fusion.md eq. 12.15).
+    if (recording_) interval_.predict(Phi_sparse_);
     covariance_predict(P_, Phi_sparse_, m.Qd, tmp_);
-    // Φ P of a one-step run is the smoother's Φ P_post (rts_step): keep it instead of recomputing it.
-    if (recording_ && run_steps_ == 1) PhiP_ = tmp_;
     x_.nav = after;
-    if (recording_) {
-      // What the smoother needs of this step (docs/fusion.md §12): the prior P and the affine map δx⁻ = A δx + d
-      // from the error after this step's updates back to the error before them (eq. 12.2).
-      P_prior_ = P_;
-      A_.setIdentity(P_.rows(), P_.cols());
-      d_.setZero(P_.rows());
-      step_updated_ = false;
-      reset_in_step_ = false;
-    }
   }
 
   // Joseph-form update with residuals r (measured - predicted), Jacobian H and noise covariance R;
@@ -221,12 +198,15 @@ class Filter {
   template <typename MatH, typename VecR, typename MatR>
   bool update(const VecR& r, const MatH& H, const MatR& R) {
     ErrorVector dx;
-    if (!joseph_update(P_, H, r, R, dx, tmp_)) return false;
+    // Smoother: the estimate of the error at the last output epoch, its variance and its cross-covariance with the
+    // current error are conditioned on the same measurement, with the filter's S and K (docs/fusion.md eqs.
+    // 12.16-12.17).
+    const bool ok = recording_
+                        ? joseph_update(P_, H, r, R, dx, tmp_,
+                                        [&](const auto& S_ldlt, const auto& K) { interval_.update(H, r, S_ldlt, K); })
+                        : joseph_update(P_, H, r, R, dx, tmp_);
+    if (!ok) return false;
     apply(dx);
-    if (recording_) {
-      d_.noalias() += A_ * dx;  // δx_before = δx_after + δx̂ (closed-loop reset), eq. 12.2
-      step_updated_ = true;
-    }
     return true;
   }
 
@@ -264,7 +244,7 @@ class Filter {
     P_.row(k).setZero();
     P_.col(k).setZero();
     P_(k, k) = 1.0;
-    fold_reset_into_prior(k, 1.0);  // a fresh variable for the smoother too (docs/fusion.md eq. 12.11)
+    if (recording_) interval_.restart_state(k);  // a fresh variable for the smoother too (docs/fusion.md eq. 12.19)
     reset = true;
     return lru;
   }
@@ -284,11 +264,8 @@ class Filter {
     P_.middleCols<3>(v) += APa.transpose();
     P_.block<3, 3>(v, v) += APaaAt;
     P_ = 0.5 * (P_ + P_.transpose()).eval();
-    // δx_new = J δx_old ⇒ δx⁻ = A J⁻¹ δx_new, J⁻¹ = I − E_v A E_φᵀ (eq. 12.3).
-    if (recording_) {
-      A_.middleCols<3>(a) -= A_.middleCols<3>(v) * A;
-      step_updated_ = true;
-    }
+    // The smoother's cross-covariance follows the coordinate change: Γ ← Γ Jᵀ (docs/fusion.md eq. 12.18).
+    if (recording_) interval_.reexpress(v, a, A);
   }
 
   // Reset a clock to a new value with a large variance (receiver clock jump).
@@ -298,7 +275,7 @@ class Filter {
     P_.row(c).setZero();
     P_.col(c).setZero();
     P_(c, c) = sigma_m * sigma_m;
-    fold_reset_into_prior(c, sigma_m * sigma_m);
+    if (recording_) interval_.restart_state(c);  // docs/fusion.md eq. 12.19
   }
   void reset_drift(double value_mps, double sigma_mps) {
     const int d = drift_block_.offset;
@@ -306,40 +283,19 @@ class Filter {
     P_.row(d).setZero();
     P_.col(d).setZero();
     P_(d, d) = sigma_mps * sigma_mps;
-    fold_reset_into_prior(d, sigma_mps * sigma_mps);
+    if (recording_) interval_.restart_state(d);  // docs/fusion.md eq. 12.19
   }
 
-  // A reset makes state i a fresh variable, independent of everything before: for the smoother it is part of the
-  // transition of this step (row i of Φ zero, prior variance var, corrections to i before the reset void; eq. 12.11).
-  void fold_reset_into_prior(int i, double var) {
-    if (!recording_) return;
-    PhiT_.col(i).setZero();
-    P_prior_.row(i).setZero();
-    P_prior_.col(i).setZero();
-    P_prior_(i, i) = var;
-    d_(i) = 0.0;
-    step_updated_ = true;
-    reset_in_step_ = true;
+  /// Start a smoother interval at the current step (an output epoch, after all its updates; docs/fusion.md eq.
+  /// 12.14); from here on every prediction, update, re-expression and reset is also applied to the interval.
+  void smoother_restart() {
+    interval_.restart(P_);
+    recording_ = true;
   }
-
-  /// Start keeping the per-step smoother quantities (before the first predict).
-  void record_for_smoother() { recording_ = true; }
-  /// Whether the step that just ended changed the covariance by an update or reset (then its backward map must be
-  /// closed at this step; otherwise the next step's transition may be composed into it, eq. 12.13).
-  bool step_updated() const { return step_updated_; }
-  /// Backward map of the run of steps that just ended (call after all updates of its last step); the next
-  /// predict() starts a new run.
-  void smoother_step(RtsStep& out) {
-    if (run_steps_ != 1) PhiP_.noalias() = PhiT_.transpose() * P_post_prev_;
-    // A reset folded into Φ (eq. 12.11) zeroes rows of Φ after Φ P was kept: recompute it then.
-    if (reset_in_step_) PhiP_.noalias() = PhiT_.transpose() * P_post_prev_;
-    rts_step(P_post_prev_, PhiT_.transpose(), P_prior_, A_, d_, PhiP_, out);
-    run_open_ = false;
-  }
-  /// Whether steps have been predicted since the last closed run.
-  bool run_open() const { return run_open_; }
-  /// End the current run without computing its map (before the first output epoch nothing is stored).
-  void drop_smoother_step() { run_open_ = false; }
+  /// The backward record of the interval from the last smoother_restart() to the current step (eq. 12.20).
+  void smoother_close(RtsSegment& out) const { interval_.close(P_, out); }
+  /// Stop the smoother's bookkeeping (a re-initialization: the backward pass cannot cross it).
+  void smoother_stop() { recording_ = false; }
 
   // check_covariance: also the symmetry / positive semi-definiteness test (an LDLT: done at the output epochs only).
   bool healthy(std::string& why, bool check_covariance) const {
@@ -397,16 +353,11 @@ class Filter {
   std::vector<double> mp_value_;
   std::vector<gnss::SatId> mp_sat_;
   std::vector<int64_t> mp_last_ns_;
-  // Smoother: the posterior at the start of the current run of steps, the run's composed transition, the last
-  // step's prior and update map (eqs. 12.2, 12.13).
-  bool recording_ = false;
-  bool run_open_ = false;
-  bool step_updated_ = false;
-  bool reset_in_step_ = false;
-  int run_steps_ = 0;
   ColumnSparse<ins::kMaxErrorDim> Phi_sparse_;
-  ErrorMatrix P_post_prev_, PhiT_, P_prior_, A_, PhiP_;  // PhiT_: the run's Φ, transposed
-  ErrorVector d_;
+  // Smoother: the interval since the last output epoch (docs/fusion.md eqs. 12.14-12.20), kept from the first
+  // output epoch on.
+  bool recording_ = false;
+  RtsInterval interval_;
 };
 
 // Median of v (reorders v; no copy).
@@ -497,12 +448,11 @@ class Runner {
     }
     f.init(nav0, imu0, filter_sigma_yaw_rad);
     EngineSummary& sum = result.summary;
-    // Smoother (docs/fusion.md §12): one composed backward map per output epoch, built step by step.
+    // Smoother (docs/fusion.md §12): one backward record per output epoch, carried forward from each output epoch
+    // to the next by the filter (eqs. 12.14-12.20).
     const bool smooth = o_.smoother_enabled;
-    if (smooth) f.record_for_smoother();
     const int n_state = f.layout().dim();
-    RtsAccumulator acc(n_state);
-    RtsStep step;
+    RtsSegment segment;
     RtsStore segments(n_state);
     std::vector<ins::InsState> nominal_at_output;
     // Storage sized once from the data span (no reallocation on the per-epoch path; docs/performance.md).
@@ -587,21 +537,16 @@ class Runner {
         return;
       }
       if (stance) last_stance = f.x();
-      // Smoother: close the run of steps at an update or an output epoch (eq. 12.13), else compose on.
-      if (smooth && !reinitialized_at && (f.step_updated() || output_now)) {
-        if (segment_open) {
-          f.smoother_step(step);
-          acc.append(step);
-        } else {
-          f.drop_smoother_step();
-        }
-      }
       if (output_now) {
         while (next_out_ns <= inc.t1.ns()) next_out_ns += out_period_ns;
         result.epochs.push_back(output(f.x().nav, f.P(), inc.t1, stance, last_used, last_rejected));
         last_used = last_rejected = 0;
         if (smooth && !reinitialized_at) {
-          if (segment_open) segments.push(acc.take());
+          if (segment_open) {
+            f.smoother_close(segment);
+            segments.push(segment);
+          }
+          f.smoother_restart();
           segment_open = true;
           nominal_at_output.push_back(f.x());
         }
@@ -636,6 +581,7 @@ class Runner {
         }
         waiting = false;
         reinitialized_at = raw.t;
+        f.smoother_stop();
         integrator = ins::IncrementIntegrator(io);  // the increments restart at this sample
         clock_initialized = false;
         implausible_streak_ = 0;
@@ -669,12 +615,9 @@ class Runner {
       return make_error(fail_message);
     }
     if (smooth && !reinitialized_at && !result.epochs.empty()) {
-      // Steps after the last closed run (no updates since) end the tail at the last step.
-      if (segment_open && f.run_open()) {
-        f.smoother_step(step);
-        acc.append(step);
-      }
-      const RtsSegment tail = acc.take();
+      // The tail: the last output epoch -> the last step (eq. 12.10).
+      RtsSegment tail;
+      f.smoother_close(tail);
       const size_t bytes = segments.bytes() + nominal_at_output.size() * sizeof(ins::InsState);
       result.smoothed.resize(result.epochs.size());
       bool finite = true;

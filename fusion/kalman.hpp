@@ -39,9 +39,11 @@ inline void covariance_predict(ins::ErrorMatrix& P, const ColumnSparse<ins::kMax
 /// P ← (I − K H) P (I − K H)ᵀ + K R Kᵀ, symmetrized. r: residuals (measured − predicted) [measurement units],
 /// H: Jacobian w.r.t. the error state (m × n), R: measurement noise covariance (m × m). Returns false (P and dx
 /// untouched) if H P Hᵀ + R is not positive definite. With fixed-capacity H, r and R nothing is allocated.
-template <typename MatH, typename VecR, typename MatR>
+/// on_gain(ldlt, K) is called with the factorization of H P Hᵀ + R and the gain before P changes (the smoother's
+/// bookkeeping, fusion::RtsInterval::update).
+template <typename MatH, typename VecR, typename MatR, typename OnGain>
 bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR& R, ins::ErrorVector& dx,
-                   ins::ErrorMatrix& tmp) {
+                   ins::ErrorMatrix& tmp, OnGain&& on_gain) {
   using ColsMatrix = Eigen::Matrix<double, Eigen::Dynamic, MatH::RowsAtCompileTime, Eigen::ColMajor,
                                    ins::kMaxErrorDim, MatH::MaxRowsAtCompileTime>;
   using SMatrix = Eigen::Matrix<double, MatH::RowsAtCompileTime, MatH::RowsAtCompileTime, Eigen::ColMajor,
@@ -54,6 +56,7 @@ bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR
   if (ldlt.info() != Eigen::Success) return false;
   const ColsMatrix K = ldlt.solve(PHt.transpose()).transpose();
   dx.noalias() = K * r;
+  on_gain(ldlt, K);
   // (I − K H) P (I − K H)ᵀ without forming I − K H (m ≪ n): T = P − K (H P), then T − (T Hᵀ) Kᵀ; H P = (P Hᵀ)ᵀ
   // as P is symmetric. Four n×m×n products instead of two n×n×n and one n×m×n.
   tmp = P;
@@ -65,6 +68,13 @@ bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR
   P.noalias() += KR * K.transpose();
   P = 0.5 * (P + P.transpose()).eval();
   return true;
+}
+
+/// The same without a callback.
+template <typename MatH, typename VecR, typename MatR>
+bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR& R, ins::ErrorVector& dx,
+                   ins::ErrorMatrix& tmp) {
+  return joseph_update(P, H, r, R, dx, tmp, [](const auto&, const auto&) {});
 }
 
 }  // namespace pednav::fusion

@@ -67,6 +67,64 @@ RtsSegment RtsAccumulator::take() {
   return out;
 }
 
+void RtsInterval::restart(const ErrorMatrix& P_a) {
+  // At a the error is δx_a itself: Cov(δx_a, δx_a) = Var(δx_a | Y_a) = P_a|a, E[δx_a | Y_a] = 0 (eq. 12.14).
+  Gamma_ = P_a;
+  V_ = P_a;
+  mu_.setZero(P_a.rows());
+  steps_ = 0;
+}
+
+void RtsInterval::predict(const ColumnSparse<ins::kMaxErrorDim>& Phi) {
+  // Γ ← Γ Φᵀ as sums of whole columns, (Γ Φᵀ).col(r) += Φ_rc Γ.col(c), as the filter's P Φᵀ (eq. 12.15).
+  tmp_.setZero(Gamma_.rows(), Gamma_.cols());
+  Phi.add_times_transposed(Gamma_, tmp_);
+  Gamma_ = tmp_;
+  ++steps_;
+}
+
+void RtsInterval::predict(const ErrorMatrix& Phi) {
+  tmp_.noalias() = Gamma_ * Phi.transpose();
+  Gamma_ = tmp_;
+  ++steps_;
+}
+
+void RtsInterval::reexpress(int dst, int src, const Eigen::Matrix3d& B) {
+  // Γ Jᵀ = Γ + Γ E_src Bᵀ E_dstᵀ: only the dst columns change (the blocks are disjoint, no aliasing; eq. 12.18).
+  Gamma_.middleCols<3>(dst).noalias() += Gamma_.middleCols<3>(src) * B.transpose();
+}
+
+void RtsInterval::reexpress(const ErrorMatrix& J) {
+  tmp_.noalias() = Gamma_ * J.transpose();
+  Gamma_ = tmp_;
+}
+
+// A fresh variable is uncorrelated with δx_a (eq. 12.19).
+void RtsInterval::restart_state(int i) {
+  Gamma_.col(i).setZero();
+}
+
+void RtsInterval::close(const ErrorMatrix& P_b, RtsSegment& out) const {
+  const int n = static_cast<int>(Gamma_.rows());
+  if (steps_ == 0) {  // b = a: the identity map (what the per-step composition gives for no steps)
+    out.M.setIdentity(n, n);
+    out.m.setZero(n);
+    out.S.setZero(n, n);
+    return;
+  }
+  // M = Γ P_b|b⁻¹ from P_b|b Mᵀ = Γᵀ (eq. 12.20), Jacobi-scaled as in rts_step (metres, radians and clock variances
+  // up to 1e12 m² in one matrix): D = diag(P_b|b)^(-1/2), (D P D)(D⁻¹ Mᵀ) = D Γᵀ.
+  const ErrorVector D = P_b.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+  const ErrorMatrix scaled = D.asDiagonal() * P_b * D.asDiagonal();
+  const Eigen::LDLT<ErrorMatrix> ldlt(scaled);
+  const ErrorMatrix Mt = D.asDiagonal() * ldlt.solve(D.asDiagonal() * Gamma_.transpose());
+  out.M = Mt.transpose();
+  out.m = mu_;
+  out.S = V_;  // S = Var(δx_a | δx_b, Y_b) = V − M Γᵀ (eq. 12.20)
+  out.S.noalias() -= out.M * Gamma_.transpose();
+  out.S = 0.5 * (out.S + out.S.transpose()).eval();
+}
+
 void RtsStore::push(const RtsSegment& s) {
   const int n = n_;
   for (int c = 0; c < n; ++c) {

@@ -1,10 +1,11 @@
 // Rauch-Tung-Striebel smoothing of a closed-loop (feedback) error-state filter, as pure linear algebra: no INS,
-// no I/O. The forward filter hands over, per mechanization step (or per run of steps without updates, eq. 12.13),
-// its posterior covariance, the transition and the prior covariance of the next step, and how that next step's
-// updates moved the nominal state; the accumulator composes the per-step backward recursion between output epochs
-// so that only one record per output epoch is stored (docs/fusion.md §12 "Smoother", eqs. 12.1-12.13; memory and
-// speed: docs/performance.md). Working matrices have a fixed capacity (ins::ErrorMatrix): no heap allocation per
-// step; the stored records are packed doubles in one growing array.
+// no I/O. Between two output epochs a < b the forward filter feeds its own events (prediction, updates with their
+// gains, re-expressions, state resets) into RtsInterval, which carries the cross-covariance of the error at a with
+// the current error and closes the interval at b into one record per output epoch (docs/fusion.md §12 "Smoother",
+// eqs. 12.14-12.20); rts_backward runs the records backwards (eq. 12.10). The per-step backward maps (rts_step,
+// RtsAccumulator, eqs. 12.1-12.13) are the earlier formulation of the same records, kept as the reference the tests
+// compare against. Memory and speed: docs/performance.md. Working matrices have a fixed capacity (ins::ErrorMatrix):
+// no heap allocation per step; the stored records are packed doubles in one growing array.
 #pragma once
 
 #include <Eigen/Core>
@@ -12,6 +13,7 @@
 #include <functional>
 #include <vector>
 
+#include "core/column_sparse.hpp"
 #include "ins/error_state.hpp"
 
 namespace pednav::fusion {
@@ -20,6 +22,7 @@ using ins::ErrorMatrix;
 using ins::ErrorVector;
 
 /// Backward map of one step j -> j+1 (docs/fusion.md eq. 12.7): ŝ_j = G ŝ_{j+1} + g,  P_s,j = Σ + G P_s,{j+1} Gᵀ.
+/// Reference formulation (tests, benchmarks); the engine builds its records with RtsInterval.
 struct RtsStep {
   ErrorMatrix G;      ///< C_j A_{j+1}  (n x n)
   ErrorVector g;      ///< C_j d_{j+1}  (n)
@@ -49,7 +52,8 @@ struct RtsSegment {
   ErrorMatrix S;
 };
 
-/// Composes steps forward in time (M ← M G, m ← m + M g, S ← S + M Σ Mᵀ) into one segment per output epoch.
+/// Composes steps forward in time (M ← M G, m ← m + M g, S ← S + M Σ Mᵀ) into one segment per output epoch
+/// (reference formulation of the segments RtsInterval builds; tests and benchmarks).
 class RtsAccumulator {
  public:
   /// Start an empty segment (identity map) for an n-dimensional error state.
@@ -68,6 +72,73 @@ class RtsAccumulator {
   ErrorMatrix tmp_;
   int steps_ = 0;
 };
+
+/// Forward bookkeeping of the smoother over one interval between output epochs a < b (docs/fusion.md §12.3b,
+/// eqs. 12.14-12.20), carried along with the filter's own events instead of a backward map per step:
+/// Γ = Cov(δx_a, δx_j | Y_j) (the error at the interval's start against the current error), μ = E[δx_a | Y_j] and
+/// V = Var(δx_a | Y_j). close() turns them into the segment (12.9) that rts_backward reads: M = Γ P_b|b⁻¹, m = μ,
+/// S = V − M Γᵀ. Fixed-capacity storage: nothing is allocated per call (with fixed-capacity H, r, K).
+class RtsInterval {
+ public:
+  /// An empty interval of an n-dimensional error state (restart() before use).
+  explicit RtsInterval(int n = 0) { restart(ErrorMatrix::Zero(n, n)); }
+  /// Start the interval at output epoch a: Γ = V = P_a|a (the filter covariance after all of a's updates), μ = 0
+  /// (eq. 12.14).
+  void restart(const ErrorMatrix& P_a);
+  /// Prediction δx⁻ = Φ δx + w (w independent of δx_a): Γ ← Γ Φᵀ (eq. 12.15), Φ by its non-zeros.
+  void predict(const ColumnSparse<ins::kMaxErrorDim>& Phi);
+  /// The same with a dense Φ.
+  void predict(const ErrorMatrix& Phi);
+  /// A Kalman update of the filter with residual r (measured − predicted), Jacobian H (m × n), the factorization
+  /// of its innovation covariance S = H P Hᵀ + R and the gain K = P Hᵀ S⁻¹ it used; the correction K r is fed back
+  /// (closed loop) (eqs. 12.16-12.17): with L = Γ Hᵀ, μ ← μ + L S⁻¹ r, V ← V − L S⁻¹ Lᵀ, Γ ← Γ − L Kᵀ.
+  template <typename MatH, typename VecR, typename Ldlt, typename MatK>
+  void update(const MatH& H, const VecR& r, const Ldlt& S_ldlt, const MatK& K);
+  /// Re-expression of the error coordinates δx_new = J δx_old, J = I + E_dst B E_srcᵀ on two disjoint 3-blocks
+  /// (form D, docs/fusion.md eq. 5.9): Γ ← Γ Jᵀ (eq. 12.18).
+  void reexpress(int dst, int src, const Eigen::Matrix3d& B);
+  /// The same for a general (dense) J.
+  void reexpress(const ErrorMatrix& J);
+  /// State i restarted as a fresh variable independent of everything before (clock, drift, multipath slot reset,
+  /// docs/fusion.md §7, §12.4): Γ.col(i) ← 0 (eq. 12.19).
+  void restart_state(int i);
+  /// The segment of the interval a → b, P_b: the filter covariance at b after all its updates (eq. 12.20); the
+  /// identity map if no step was predicted since restart().
+  void close(const ErrorMatrix& P_b, RtsSegment& out) const;
+  /// Number of predictions since restart().
+  int steps() const { return steps_; }
+  /// The current Γ, μ, V (tests).
+  const ErrorMatrix& cross() const { return Gamma_; }
+  const ErrorVector& mean() const { return mu_; }
+  const ErrorMatrix& var() const { return V_; }
+
+ private:
+  ErrorMatrix Gamma_, V_, tmp_;
+  ErrorVector mu_;
+  int steps_ = 0;
+};
+
+template <typename MatH, typename VecR, typename Ldlt, typename MatK>
+void RtsInterval::update(const MatH& H, const VecR& r, const Ldlt& S_ldlt, const MatK& K) {
+  using ColsMatrix = Eigen::Matrix<double, Eigen::Dynamic, MatH::RowsAtCompileTime, Eigen::ColMajor, ins::kMaxErrorDim,
+                                   MatH::MaxRowsAtCompileTime>;
+  using RowsMatrix = Eigen::Matrix<double, MatH::RowsAtCompileTime, Eigen::Dynamic, Eigen::ColMajor,
+                                   MatH::MaxRowsAtCompileTime, ins::kMaxErrorDim>;
+  // L = Γ Hᵀ = Cov(δx_a, r | Y) (the measurement sees δx_a only through δx_j), as sums of whole columns of Γ over
+  // the non-zeros of H (ZUPT + ZARU: 12 of 6 x 17): L.col(i) += H(i, j) Γ.col(j).
+  ColsMatrix L;
+  L.setZero(Gamma_.rows(), H.rows());
+  for (int j = 0; j < H.cols(); ++j) {
+    for (int i = 0; i < H.rows(); ++i) {
+      const double h = H(i, j);
+      if (h != 0.0) L.col(i) += h * Gamma_.col(j);
+    }
+  }
+  const RowsMatrix W = S_ldlt.solve(L.transpose());  // S⁻¹ Lᵀ
+  mu_.noalias() += W.transpose() * r;                // eq. 12.16: δx_a conditioned on the innovation
+  V_.noalias() -= L * W;                             // eq. 12.16
+  Gamma_.noalias() -= L * K.transpose();  // eq. 12.17: Cov(δx_a, δx⁻ − K r | y) = Γ − L S⁻¹ H P = Γ (I − K H)ᵀ
+}
 
 /// The stored segments, packed: per record M (n², column-major), m (n) and the upper triangle of the symmetric S
 /// (n(n+1)/2), all double, in one array (one allocation growing geometrically, or none after reserve()).

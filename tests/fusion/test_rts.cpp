@@ -1,7 +1,10 @@
 // RTS core (fusion/rts.*) on a linear-Gaussian problem: a closed-loop Kalman filter (nominal corrected after each
-// update, error estimate reset to zero) feeding the same accumulator/backward pass as the engine must reproduce
-// the batch weighted least-squares solution of the whole problem (states and their covariances) — issue 6's
-// oracle. docs/fusion.md §12.
+// update, error estimate reset to zero) feeding the interval bookkeeping of the engine (RtsInterval, docs/fusion.md
+// eqs. 12.14-12.20) and, as the reference, the per-step backward maps (rts_step + RtsAccumulator, eqs. 12.1-12.11),
+// then the same backward pass, must reproduce the batch weighted least-squares solution of the whole problem (states
+// and their covariances) — issue 6's oracle. A second problem with everything the engine does inside a step
+// (sequential updates, form-D re-expressions, clock/drift resets) checks that both formulations give the same
+// records. docs/fusion.md §12.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -119,7 +122,8 @@ struct SmootherRun {
   std::vector<int> output_steps;
   std::vector<VectorXd> filtered;     // nominal (= filtered mean) at the outputs
   std::vector<MatrixXd> filtered_P;
-  std::vector<fusion::RtsSmoothed> smoothed;
+  std::vector<fusion::RtsSmoothed> smoothed;      // per-step composition (reference)
+  std::vector<fusion::RtsSmoothed> smoothed_new;  // interval bookkeeping (the engine's)
 };
 
 // Closed-loop KF in the engine's order: predict, sequential updates (nominal corrected, error reset), record the
@@ -129,12 +133,14 @@ SmootherRun run_closed_loop(const Problem& p, int first_output, int every) {
   VectorXd x = p.m0;
   MatrixXd P = p.P0;
   fusion::RtsAccumulator acc(kN);
-  std::vector<fusion::RtsSegment> segments;
+  fusion::RtsInterval interval(kN);
+  std::vector<fusion::RtsSegment> segments, segments_new;
   bool open = false;
   for (int k = 0; k < kSteps; ++k) {
     const MatrixXd P_post = P;
     x = p.Phi * x;
     P = p.Phi * P * p.Phi.transpose() + p.Q;
+    interval.predict(p.Phi);
     const MatrixXd P_prior = P;
     const MatrixXd A = MatrixXd::Identity(kN, kN);
     VectorXd d = VectorXd::Zero(kN);
@@ -142,7 +148,9 @@ SmootherRun run_closed_loop(const Problem& p, int first_output, int every) {
       if (m.step != k + 1) continue;
       const MatrixXd S = m.H * P * m.H.transpose() + m.R;
       const MatrixXd K = P * m.H.transpose() * S.inverse();
-      const VectorXd dx = K * (m.y - m.H * x);
+      const VectorXd r = m.y - m.H * x;
+      const VectorXd dx = K * r;
+      interval.update(m.H, r, Eigen::LDLT<MatrixXd>(S), K);
       const MatrixXd IKH = MatrixXd::Identity(kN, kN) - K * m.H;
       P = IKH * P * IKH.transpose() + K * m.R * K.transpose();
       x += dx;     // closed loop: the nominal takes the correction, the error estimate is zero again
@@ -151,7 +159,12 @@ SmootherRun run_closed_loop(const Problem& p, int first_output, int every) {
     if (open) acc.append(fusion::rts_step(P_post, p.Phi, P_prior, A, d));
     const int step = k + 1;
     if (step >= first_output && (step - first_output) % every == 0) {
-      if (open) segments.push_back(acc.take());
+      if (open) {
+        segments.push_back(acc.take());
+        segments_new.emplace_back();
+        interval.close(P, segments_new.back());
+      }
+      interval.restart(P);
       open = true;
       out.output_steps.push_back(step);
       out.filtered.push_back(x);
@@ -159,6 +172,9 @@ SmootherRun run_closed_loop(const Problem& p, int first_output, int every) {
     }
   }
   out.smoothed = fusion::rts_backward(segments, acc.take(), P);
+  fusion::RtsSegment tail;
+  interval.close(P, tail);
+  out.smoothed_new = fusion::rts_backward(segments_new, tail, P);
   return out;
 }
 
@@ -171,30 +187,183 @@ TEST_P(RtsLinearGaussian, EqualsBatchWeightedLeastSquares) {
   const SmootherRun r = run_closed_loop(p, first_output, every);
   ASSERT_EQ(r.smoothed.size(), r.output_steps.size());
   ASSERT_GE(r.output_steps.size(), 3u);
-  double worst_x = 0, worst_P = 0, worst_fwd = 0;
+  ASSERT_EQ(r.smoothed_new.size(), r.output_steps.size());
+  double worst_x = 0, worst_P = 0, worst_fwd = 0, worst_x_new = 0, worst_P_new = 0;
   for (size_t i = 0; i < r.output_steps.size(); ++i) {
     const int k = r.output_steps[i];
     const VectorXd xs = r.filtered[i] + r.smoothed[i].dx;  // nominal ⊞ smoothed error (linear: +)
     worst_x = std::max(worst_x, (xs - X.segment(k * kN, kN)).cwiseAbs().maxCoeff());
     worst_P = std::max(worst_P, (r.smoothed[i].P - cov.block(k * kN, k * kN, kN, kN)).cwiseAbs().maxCoeff());
+    const VectorXd xs_new = r.filtered[i] + r.smoothed_new[i].dx;
+    worst_x_new = std::max(worst_x_new, (xs_new - X.segment(k * kN, kN)).cwiseAbs().maxCoeff());
+    worst_P_new =
+        std::max(worst_P_new, (r.smoothed_new[i].P - cov.block(k * kN, k * kN, kN, kN)).cwiseAbs().maxCoeff());
     worst_fwd = std::max(worst_fwd, (r.filtered[i] - X.segment(k * kN, kN)).cwiseAbs().maxCoeff());
     for (int j = 0; j < kN; ++j) {
       EXPECT_LE(r.smoothed[i].P(j, j), r.filtered_P[i](j, j) + kTolSigmaOrder) << "step " << k << " state " << j;
+      EXPECT_LE(r.smoothed_new[i].P(j, j), r.filtered_P[i](j, j) + kTolSigmaOrder) << "step " << k << " state " << j;
     }
   }
   EXPECT_LT(worst_x, kTolState);
   EXPECT_LT(worst_P, kTolCov);
+  EXPECT_LT(worst_x_new, kTolState);
+  EXPECT_LT(worst_P_new, kTolCov);
   // The filter alone is not the batch solution (otherwise the test could not fail).
   EXPECT_GT(worst_fwd, 1e3 * kTolState);
   std::printf("[ rts ] outputs every %d steps from %d: max |x_s − x_WLS| %.2e, max |P_s − P_WLS| %.2e "
-              "(forward vs WLS %.2e)\n",
-              every, first_output, worst_x, worst_P, worst_fwd);
+              "(interval bookkeeping %.2e, %.2e; forward vs WLS %.2e)\n",
+              every, first_output, worst_x, worst_P, worst_x_new, worst_P_new, worst_fwd);
 }
 
 // Every step an output (no composition), outputs every 3 steps from step 2 (steps before the first output and
 // after the last one are composed into the tail), and a single long segment.
 INSTANTIATE_TEST_SUITE_P(Decimation, RtsLinearGaussian,
                          ::testing::Values(std::pair{1, 1}, std::pair{2, 3}, std::pair{1, 13}));
+
+// Everything the engine does inside a mechanization step (docs/fusion.md §12.1, §12.4), on a random 9-state problem:
+// a dense random transition per step; ZUPT-like updates (rows without clock and drift columns), each followed by a
+// form-D-like re-expression δx_new = J δx_old, J = I + E_v B E_φᵀ, half of the time; clock and drift resets (fresh
+// variables); GNSS-like updates that see every state, after the resets. One filter run feeds both bookkeepings; the
+// records (M, m, S) and the smoothed errors and covariances must agree. Errors are measured in units of the smoothed
+// σ (D = diag(P_s)^½ at each end of a record: |D_a⁻¹ ΔM D_b|, |D_a⁻¹ Δm|, |D_a⁻¹ ΔS D_a⁻¹|), so the unit-scale states
+// are not hidden behind the clock's variance of 1e4.
+constexpr int kNe = 9;  // 0-2 "velocity", 3-5 "attitude", 6 "bias", 7 "clock", 8 "drift"
+constexpr int kVelE = 0, kAttE = 3, kClockE = 7, kDriftE = 8;
+constexpr int kStepsE = 150;
+constexpr double kTolRel = 1e-9;  // [smoothed σ] interval bookkeeping vs per-step composition
+
+TEST(RtsInterval, EqualsPerStepCompositionWithReexpressionsAndResets) {
+  std::mt19937 rng(20240917u);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  const int n = kNe;
+  const MatrixXd I = MatrixXd::Identity(n, n);
+  auto randn = [&](int rows, int cols) {
+    MatrixXd M(rows, cols);
+    for (int j = 0; j < cols; ++j) {
+      for (int i = 0; i < rows; ++i) M(i, j) = nd(rng);
+    }
+    return M;
+  };
+  MatrixXd P = random_spd(rng, n, 1.0);
+  P(kClockE, kClockE) += 1e4;  // an unconverged clock next to unit-scale states (the solves are Jacobi-scaled)
+  fusion::RtsAccumulator acc(n);
+  fusion::RtsInterval interval(n);
+  std::vector<fusion::RtsSegment> ref_segments, new_segments;
+  std::vector<MatrixXd> filtered_P;
+  bool open = false;
+  int n_updates = 0, n_reexpressions = 0, n_resets = 0, n_reset_after_update = 0;
+  // Joseph update of the filter with a residual drawn with the innovation covariance; the interval sees the same S
+  // and K. Returns the correction fed back into the nominal (closed loop).
+  auto kalman = [&](const MatrixXd& H) -> VectorXd {
+    const int m = static_cast<int>(H.rows());
+    const MatrixXd R = random_spd(rng, m, 0.1);
+    const MatrixXd S = H * P * H.transpose() + R;
+    const Eigen::LDLT<MatrixXd> ldlt(S);
+    const MatrixXd K = ldlt.solve(H * P).transpose();
+    const VectorXd r = Eigen::LLT<MatrixXd>(S).matrixL() * randn(m, 1);
+    if (open) interval.update(H, r, ldlt, K);
+    const MatrixXd IKH = I - K * H;
+    P = IKH * P * IKH.transpose() + K * R * K.transpose();
+    ++n_updates;
+    return K * r;
+  };
+  for (int k = 0; k < kStepsE; ++k) {
+    MatrixXd Phi = I + 0.05 * randn(n, n);
+    Phi(kClockE, kDriftE) = 0.05;
+    const MatrixXd Qd = random_spd(rng, n, 1e-3);
+    const MatrixXd P_post = P;
+    P = Phi * P * Phi.transpose() + Qd;
+    if (open) interval.predict(Phi);
+    // Reference quantities of this step (eqs. 12.1-12.3, 12.11): prior, δx⁻ = A δx + d, resets folded in.
+    MatrixXd Phi_ref = Phi, P_prior = P, A = I;
+    VectorXd d = VectorXd::Zero(n);
+    bool updated = false;
+    if (uni(rng) < 0.6) {
+      MatrixXd H = randn(3, n);
+      H.col(kClockE).setZero();
+      H.col(kDriftE).setZero();
+      d += A * kalman(H);
+      updated = true;
+      if (uni(rng) < 0.5) {
+        const Eigen::Matrix3d B = 0.3 * randn(3, 3);
+        MatrixXd J = I;
+        J.block<3, 3>(kVelE, kAttE) = B;
+        P = J * P * J.transpose();
+        A.middleCols<3>(kAttE) -= A.middleCols<3>(kVelE) * B;  // A ← A J⁻¹, J⁻¹ = I − E_v B E_φᵀ (eq. 12.3)
+        if (open) interval.reexpress(kVelE, kAttE, B);
+        ++n_reexpressions;
+      }
+    }
+    if (uni(rng) < 0.15) {
+      const int i = uni(rng) < 0.5 ? kClockE : kDriftE;
+      const double var = i == kClockE ? 900.0 : 1.0;
+      P.row(i).setZero();
+      P.col(i).setZero();
+      P(i, i) = var;
+      Phi_ref.row(i).setZero();
+      P_prior.row(i).setZero();
+      P_prior.col(i).setZero();
+      P_prior(i, i) = var;
+      d(i) = 0.0;
+      if (open) interval.restart_state(i);
+      ++n_resets;
+      if (updated) ++n_reset_after_update;
+    }
+    if (uni(rng) < 0.3) d += A * kalman(randn(4, n));
+    if (open) acc.append(fusion::rts_step(P_post, Phi_ref, P_prior, A, d));
+    if ((k + 1) % 9 == 4) {  // output epochs: steps 4, 13, 22, ...
+      if (open) {
+        ref_segments.push_back(acc.take());
+        new_segments.emplace_back();
+        interval.close(P, new_segments.back());
+      }
+      interval.restart(P);
+      open = true;
+      filtered_P.push_back(P);
+    }
+  }
+  ASSERT_GT(n_reexpressions, 10);
+  ASSERT_GT(n_reset_after_update, 3);
+  ASSERT_GT(n_resets, n_reset_after_update);
+  const fusion::RtsSegment ref_tail = acc.take();
+  fusion::RtsSegment new_tail;
+  interval.close(P, new_tail);
+  const std::vector<fusion::RtsSmoothed> ref = fusion::rts_backward(ref_segments, ref_tail, P);
+  const std::vector<fusion::RtsSmoothed> got = fusion::rts_backward(new_segments, new_tail, P);
+  ASSERT_EQ(ref.size(), filtered_P.size());
+  ASSERT_EQ(got.size(), ref.size());
+  auto sigma_inv = [](const MatrixXd& Ps) -> VectorXd { return Ps.diagonal().cwiseSqrt().cwiseInverse(); };
+  double worst_M = 0, worst_m = 0, worst_S = 0, worst_dx = 0, worst_P = 0, smoothing = 0;
+  for (size_t i = 0; i <= ref_segments.size(); ++i) {
+    const bool tail = i == ref_segments.size();
+    const fusion::RtsSegment& a = tail ? ref_tail : ref_segments[i];
+    const fusion::RtsSegment& b = tail ? new_tail : new_segments[i];
+    const VectorXd Da = sigma_inv(ref[i].P);
+    const VectorXd Db_inv = (tail ? P : ref[i + 1].P).diagonal().cwiseSqrt();
+    worst_M = std::max(worst_M, (Da.asDiagonal() * (b.M - a.M) * Db_inv.asDiagonal()).cwiseAbs().maxCoeff());
+    worst_m = std::max(worst_m, (Da.asDiagonal() * (b.m - a.m)).cwiseAbs().maxCoeff());
+    worst_S = std::max(worst_S, (Da.asDiagonal() * (b.S - a.S) * Da.asDiagonal()).cwiseAbs().maxCoeff());
+    worst_dx = std::max(worst_dx, (Da.asDiagonal() * (got[i].dx - ref[i].dx)).cwiseAbs().maxCoeff());
+    worst_P = std::max(worst_P, (Da.asDiagonal() * (got[i].P - ref[i].P) * Da.asDiagonal()).cwiseAbs().maxCoeff());
+    smoothing = std::max(smoothing, (sigma_inv(filtered_P[i]).asDiagonal() * ref[i].dx).cwiseAbs().maxCoeff());
+    for (int j = 0; j < n; ++j) {
+      EXPECT_LE(got[i].P(j, j), filtered_P[i](j, j) * (1.0 + kTolRel)) << "output " << i << " state " << j;
+    }
+  }
+  EXPECT_LT(worst_M, kTolRel);
+  EXPECT_LT(worst_m, kTolRel);
+  EXPECT_LT(worst_S, kTolRel);
+  EXPECT_LT(worst_dx, kTolRel);
+  EXPECT_LT(worst_P, kTolRel);
+  // The smoothed errors are not small against the filtered σ (otherwise agreeing means would prove nothing).
+  EXPECT_GT(smoothing, 0.1);
+  std::printf("[ rts ] interval vs per-step, %zu records, %d updates, %d re-expressions, %d resets (%d after an "
+              "update in the same step): max error [σ] M %.1e m %.1e S %.1e, smoothed dx %.1e P %.1e (|dx| up to "
+              "%.2f filtered σ)\n",
+              ref.size(), n_updates, n_reexpressions, n_resets, n_reset_after_update, worst_M, worst_m, worst_S,
+              worst_dx, worst_P, smoothing);
+}
 
 TEST(RtsStep, ResetFoldedIntoTransitionDecouplesTheState) {
   // A state reset (fresh variable, docs/fusion.md eq. 12.11) is a transition row of zeros: the smoothed error
