@@ -48,8 +48,19 @@ bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR
                                    ins::kMaxErrorDim, MatH::MaxRowsAtCompileTime>;
   using SMatrix = Eigen::Matrix<double, MatH::RowsAtCompileTime, MatH::RowsAtCompileTime, Eigen::ColMajor,
                                 MatH::MaxRowsAtCompileTime, MatH::MaxRowsAtCompileTime>;
+  // H of a ZUPT or GNSS epoch touches a few states only (ZUPT: velocity, attitude, gyro bias): P Hᵀ and T Hᵀ are
+  // summed over H's non-zero columns (n·m per column instead of n·n·m for the whole product).
+  int nz[ins::kMaxErrorDim];
+  int n_nz = 0;
+  for (int c = 0; c < H.cols(); ++c) {
+    if (!H.col(c).isZero(0.0)) nz[n_nz++] = c;
+  }
+  auto times_Ht = [&](const ins::ErrorMatrix& A, ColsMatrix& out) {
+    out.setZero(A.rows(), H.rows());
+    for (int k = 0; k < n_nz; ++k) out.noalias() += A.col(nz[k]) * H.col(nz[k]).transpose();
+  };
   ColsMatrix PHt;
-  PHt.noalias() = P * H.transpose();
+  times_Ht(P, PHt);
   SMatrix S = R;
   S.noalias() += H * PHt;
   const Eigen::LDLT<SMatrix> ldlt(S);
@@ -58,14 +69,15 @@ bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR
   dx.noalias() = K * r;
   on_gain(ldlt, K);
   // (I − K H) P (I − K H)ᵀ without forming I − K H (m ≪ n): T = P − K (H P), then T − (T Hᵀ) Kᵀ; H P = (P Hᵀ)ᵀ
-  // as P is symmetric. Four n×m×n products instead of two n×n×n and one n×m×n.
+  // as P is symmetric. Two n×m×n products and two sparse n×n×m ones instead of two n×n×n and one n×m×n.
   tmp = P;
   tmp.noalias() -= K * PHt.transpose();
-  const ColsMatrix THt = tmp * H.transpose();
+  ColsMatrix THt;
+  times_Ht(tmp, THt);
+  // T − (T Hᵀ) Kᵀ + K R Kᵀ = T − (T Hᵀ − K R) Kᵀ: one n×m×n product for the last two terms.
+  THt.noalias() -= K * R;
   P = tmp;
   P.noalias() -= THt * K.transpose();
-  const ColsMatrix KR = K * R;
-  P.noalias() += KR * K.transpose();
   P = 0.5 * (P + P.transpose()).eval();
   return true;
 }

@@ -21,6 +21,7 @@
 #include "io/run_command.hpp"
 #include "io/scenario_config.hpp"
 #include "sim/simulator.hpp"
+#include "tests/sim/fixtures.hpp"
 
 namespace pednav {
 namespace {
@@ -67,11 +68,7 @@ class ForestWalkTc : public ::testing::Test {
     fusion::EngineOptions o = io::engine_options(c);
     o.base_position_e = g_run->sim.gnss.p_base_e;
     o.record_gnss_rows = true;  // per-measurement w-test records for the fault-rejection test
-    fusion::EngineInputs in;
-    in.imu = &g_run->sim.imu;
-    in.nav = &g_run->sim.nav;
-    in.rover = &g_run->sim.gnss.rover.epochs;
-    in.base = &g_run->sim.gnss.base.epochs;
+    const fusion::EngineInputs in = test::engine_inputs(g_run->sim);
     const auto t0 = std::chrono::steady_clock::now();
     auto r = fusion::run_forward(in, o);
     g_run->wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -237,12 +234,7 @@ TEST(ForestWalkTcHeading, StaticStartGnssNoiseDoesNotEndTheHeadingFit) {
   c.imu.spec = file->scenario.imu.spec;
   fusion::EngineOptions o = io::engine_options(c);
   o.base_position_e = s->gnss.p_base_e;
-  fusion::EngineInputs in;
-  in.imu = &s->imu;
-  in.nav = &s->nav;
-  in.rover = &s->gnss.rover.epochs;
-  in.base = &s->gnss.base.epochs;
-  auto r = fusion::run_forward(in, o);
+  auto r = fusion::run_forward(test::engine_inputs(*s), o);
   ASSERT_TRUE(r.has_value()) << r.error().message;
   const auto& sum = r->summary;
   std::printf("[ forest ] seed 24: %s\n", sum.initialization.c_str());

@@ -11,7 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "fusion/engine.hpp"
 #include "io/scenario_config.hpp"
+#include "sim/simulator.hpp"
 
 namespace pednav::test {
 
@@ -71,6 +73,16 @@ inline io::ScenarioFile scenario_from_text(const std::string& text) {
   auto sc = io::parse_scenario(text, "test.yaml", ".");
   EXPECT_TRUE(sc.has_value()) << (sc ? "" : sc.error().message);
   return sc ? *sc : io::ScenarioFile{};
+}
+
+/// Engine inputs pointing into a simulation (IMU, nav, rover and base epochs); valid while `s` lives.
+inline fusion::EngineInputs engine_inputs(const sim::Simulation& s) {
+  fusion::EngineInputs in;
+  in.imu = &s.imu;
+  in.nav = &s.nav;
+  in.rover = &s.gnss.rover.epochs;
+  in.base = &s.gnss.base.epochs;
+  return in;
 }
 
 /// A fresh empty temporary folder.
