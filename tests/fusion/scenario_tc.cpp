@@ -264,5 +264,39 @@ TEST(ForestWalkTcHeading, StaticStartGnssNoiseDoesNotEndTheHeadingFit) {
   EXPECT_LT(rms, kSeed24MaxHorizontalRmsM);
 }
 
+// Bad input (docs/fusion.md §8): a walk that never gets 10 m from its start gives no heading from motion; the
+// message says how far the INS/ZUPT track went and what to configure.
+TEST(ForestWalkTcHeading, WalkShorterThan10mIsAClearError) {
+  const char* yaml = R"(
+name: short_walk
+seed: 3
+start: {gps_week: 2300, gps_tow_s: 300000}
+origin: {lat_deg: 51.08, lon_deg: -114.13, h_m: 1050}
+route:
+  static_start_s: 20
+  static_end_s: 10
+  waypoints:
+    - {e_m: 0, n_m: 0}
+    - {e_m: 6, n_m: 0}
+imu: {rate_hz: 100, spec: crista, errors: false}
+gnss: {base_offset_enu_m: [50, 20, 0]}
+)";
+  auto file = io::parse_scenario(yaml, "short_walk.yaml", ".");
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  auto s = sim::simulate(file->scenario);
+  ASSERT_TRUE(s.has_value()) << s.error().message;
+  io::RunConfig c;
+  c.mode = "tc";
+  c.imu.spec = file->scenario.imu.spec;
+  fusion::EngineOptions o = io::engine_options(c);
+  o.base_position_e = s->gnss.p_base_e;
+  auto r = fusion::run_forward(test::engine_inputs(*s), o);
+  ASSERT_FALSE(r.has_value());
+  EXPECT_NE(r.error().message.find("cannot find the initial heading from motion: the INS/ZUPT track goes"),
+            std::string::npos)
+      << r.error().message;
+  EXPECT_NE(r.error().message.find("set initial.yaw_deg"), std::string::npos) << r.error().message;
+}
+
 }  // namespace
 }  // namespace pednav
