@@ -60,4 +60,28 @@ VerticalStats vertical_statistics(const std::vector<EpochError>& errors) {
   return v;
 }
 
+ConsistencyStats consistency_statistics(const std::vector<EpochError>& errors) {
+  ConsistencyStats c;
+  long inside = 0, inside_v = 0, n_v = 0;
+  double sum_q = 0.0;
+  for (const auto& e : errors) {
+    const double se = e.sd_enu_m.x(), sn = e.sd_enu_m.y(), su = e.sd_enu_m.z();
+    if (!(std::isfinite(se) && std::isfinite(sn) && se > 0.0 && sn > 0.0)) continue;
+    const double qe = e.d_enu.x() / se, qn = e.d_enu.y() / sn;
+    ++c.epochs;
+    inside += std::abs(qe) <= 3.0 && std::abs(qn) <= 3.0;
+    sum_q += qe * qe + qn * qn;
+    c.max_normalized_horizontal = std::max({c.max_normalized_horizontal, std::abs(qe), std::abs(qn)});
+    if (std::isfinite(su) && su > 0.0) {
+      ++n_v;
+      inside_v += std::abs(e.d_enu.z() / su) <= 3.0;
+    }
+  }
+  if (c.epochs == 0) return c;
+  c.inside_3sigma_pct = 100.0 * static_cast<double>(inside) / c.epochs;
+  c.mean_normalized_sq_horizontal = sum_q / c.epochs;
+  if (n_v > 0) c.inside_3sigma_vertical_pct = 100.0 * static_cast<double>(inside_v) / static_cast<double>(n_v);
+  return c;
+}
+
 }  // namespace pednav::eval

@@ -27,4 +27,18 @@ struct VerticalStats {
 };
 VerticalStats vertical_statistics(const std::vector<EpochError>& errors);
 
+/// Does the solution's σ deserve trust? Over the matched epochs that carry σ (EpochError::sd_enu_m finite and > 0):
+/// the share with |e_N| <= 3σ_N and |e_E| <= 3σ_E (99.5 % for a consistent Gaussian filter with uncorrelated N, E),
+/// the share with |e_U| <= 3σ_U, the mean of e_E²/σ_E² + e_N²/σ_N² (2 for a consistent filter; the N–E correlation
+/// is not in the solution files, so this is the diagonal form of the NEES) and the largest |e|/σ of E or N.
+/// Valid only for errors in the solution's own axes (no rotating alignment).
+struct ConsistencyStats {
+  int epochs = 0;                       ///< matched epochs with a horizontal σ
+  double inside_3sigma_pct = 0.0;       ///< N and E inside 3σ [%]
+  double inside_3sigma_vertical_pct = 0.0;
+  double mean_normalized_sq_horizontal = 0.0;
+  double max_normalized_horizontal = 0.0;
+};
+ConsistencyStats consistency_statistics(const std::vector<EpochError>& errors);
+
 }  // namespace pednav::eval

@@ -110,11 +110,12 @@ Expected<Evaluation> compare(const Trajectory& sol, const Trajectory& ref, const
   };
 
   std::vector<GpsTime> times;
-  std::vector<Eigen::Vector3d> s_enu, r_enu;
+  std::vector<Eigen::Vector3d> s_enu, r_enu, s_sd;
   for (const auto& sp : sol.points) {
     Eigen::Vector3d rp;
     if (!reference_at(ref, sp.t, o, rp)) continue;
     times.push_back(sp.t);
+    s_sd.push_back(sp.sd_enu_m);
     s_enu.push_back(sol_enu(sp.p));
     r_enu.push_back(ref_enu(rp));
   }
@@ -149,7 +150,7 @@ Expected<Evaluation> compare(const Trajectory& sol, const Trajectory& ref, const
   for (size_t i = 0; i < times.size(); ++i) {
     const Eigen::Vector3d d = ev.R_align * s_enu[i] + ev.t_align - r_enu[i];
     const double h = d.head<2>().norm();
-    ev.errors.push_back({times[i], d, h});
+    ev.errors.push_back({times[i], d, h, s_sd[i]});
     horiz.push_back(h);
     vert.push_back(d.z());
     sum_h += h;

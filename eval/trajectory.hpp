@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,8 @@ namespace pednav::eval {
 struct TrajectoryPoint {
   GpsTime t;
   Eigen::Vector3d p;  ///< ECEF [m] (Frame::kEcef) or local ENU [m] (Frame::kLocalEnu)
+  /// The solution's own 1σ East, North, Up [m] where the file gives it (pednav CSV sd_e_m, sd_n_m, sd_d_m), else NaN.
+  Eigen::Vector3d sd_enu_m = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 enum class Frame { kEcef, kLocalEnu };
@@ -47,6 +50,9 @@ struct EpochError {
   GpsTime t;
   Eigen::Vector3d d_enu;
   double horizontal_m = 0.0;
+  /// The solution's 1σ E, N, U at this epoch [m] (NaN when unknown), in the solution's own axes: with an alignment
+  /// that rotates about the vertical, σ_h = √(σ_E² + σ_N²) still applies but the per-axis values do not.
+  Eigen::Vector3d sd_enu_m = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 /// The statistics of evaluation.json (DESIGN.md) plus the matched epochs.

@@ -54,35 +54,20 @@ void write_compare_plots(const eval::Evaluation& ev, const CompareArgs& args, co
     hs.value_m.push_back(e.horizontal_m);
   }
   write("error_cdf.svg", error_cdf_plot("Horizontal error CDF", {hs}));
-  // Horizontal error with the +-3 sigma_h envelope (sigma_h = sqrt(sd_n^2 + sd_e^2)) when the solution has sigmas.
-  std::map<int64_t, double> sigma_h;
-  if (sol.format == "csv") {
-    if (auto tab = read_csv_table(args.solution)) {
-      const auto* wk = tab->column("gps_week");
-      const auto* tow = tab->column("gps_tow_s");
-      const auto* sn = tab->column("sd_n_m");
-      const auto* se = tab->column("sd_e_m");
-      if (wk && tow && sn && se) {
-        for (size_t i = 0; i < tab->rows; ++i) {
-          if (std::isfinite((*wk)[i]) && std::isfinite((*tow)[i])) {
-            sigma_h[GpsTime::from_week_tow(static_cast<int>((*wk)[i]), (*tow)[i]).ns()] =
-                std::hypot((*sn)[i], (*se)[i]);
-          }
-        }
-      }
-    }
-  }
+  // Horizontal error with the +-3 sigma_h envelope (sigma_h = sqrt(sd_n^2 + sd_e^2), rotation-invariant) when the
+  // solution has sigmas.
+  bool has_sigma = false;
+  for (const auto& e : ev.errors) has_sigma = has_sigma || std::isfinite(e.sd_enu_m.head<2>().norm());
   PlotSpec p = horizontal_error_plot("Horizontal error vs time", {hs});
-  if (!sigma_h.empty()) {
+  if (has_sigma) {
     PlotSeries band;
     band.title = "0..3σ_h (filter)";
     band.style = PlotStyle::kBand;
     band.color = "#1f77b4";
     for (const auto& e : ev.errors) {
-      auto it = sigma_h.find(e.t.ns());
       band.x.push_back(e.t - t0);
       band.y_low.push_back(0.0);
-      band.y_high.push_back(it == sigma_h.end() ? NAN : 3.0 * it->second);
+      band.y_high.push_back(3.0 * e.sd_enu_m.head<2>().norm());
     }
     p.series.insert(p.series.begin(), band);
   }
@@ -109,6 +94,18 @@ std::string evaluation_json(const eval::Evaluation& ev, const CompareArgs& args,
     j["closure_m"] = ev.closure_m;
     j["closure_pct_of_distance"] = ev.closure_pct_of_distance;
     j["distance_m"] = ev.distance_m;
+  }
+  // Consistency of the solution's own σ (pednav CSV solutions carry it), in its own axes: not after a rotating
+  // alignment.
+  if (args.compare.align == eval::Align::kNone) {
+    const eval::ConsistencyStats cs = eval::consistency_statistics(ev.errors);
+    if (cs.epochs > 0) {
+      j["consistency"] = {{"epochs_with_sigma", cs.epochs},
+                          {"inside_3sigma_pct", cs.inside_3sigma_pct},
+                          {"inside_3sigma_vertical_pct", cs.inside_3sigma_vertical_pct},
+                          {"mean_normalized_sq_horizontal", cs.mean_normalized_sq_horizontal},
+                          {"max_normalized_horizontal", cs.max_normalized_horizontal}};
+    }
   }
   const eval::VerticalStats v = eval::vertical_statistics(ev.errors);
   j["vertical"] = {{"rms_m", v.rms_m}, {"mean_m", v.mean_m}, {"std_m", v.std_m}, {"p95_abs_m", v.p95_abs_m},
@@ -148,6 +145,15 @@ std::string evaluation_markdown(const eval::Evaluation& ev, const CompareArgs& a
   if (ev.has_closure) {
     s += fmt::format("| closure | {:.3f} m ({:.2f} % of {:.1f} m) |\n", ev.closure_m, ev.closure_pct_of_distance,
                      ev.distance_m);
+  }
+  if (args.compare.align == eval::Align::kNone) {
+    const eval::ConsistencyStats cs = eval::consistency_statistics(ev.errors);
+    if (cs.epochs > 0) {
+      s += fmt::format("| inside 3σ (N and E / U, the solution's own σ) | {:.1f} % / {:.1f} % of {} epochs |\n"
+                       "| mean (e_E/σ_E)² + (e_N/σ_N)² (2 if consistent) / max \\|e\\|/σ | {:.2f} / {:.1f} |\n",
+                       cs.inside_3sigma_pct, cs.inside_3sigma_vertical_pct, cs.epochs, cs.mean_normalized_sq_horizontal,
+                       cs.max_normalized_horizontal);
+    }
   }
   const eval::VerticalStats v = eval::vertical_statistics(ev.errors);
   s += fmt::format("| vertical mean / sd | {:.3f} m / {:.3f} m |\n| vertical p95 abs / max abs | {:.3f} m / {:.3f} m |\n",

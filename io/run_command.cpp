@@ -9,6 +9,7 @@
 
 #include "core/geodesy.hpp"
 #include "core/rotation.hpp"
+#include "eval/statistics.hpp"
 #include "eval/trajectory.hpp"
 #include "gnss/rtklib/rinex.hpp"
 #include "io/atomic_file.hpp"
@@ -301,7 +302,10 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
     auto evaluate = [&](const std::vector<SolutionRow>& rs, const std::string& csv, const std::string& json_name,
                         const std::string& key, const std::string& what) -> Expected<void> {
       eval::Trajectory sol;
-      for (const auto& r : rs) sol.points.push_back({r.time, r.p_e});
+      for (const auto& r : rs) {
+        const Eigen::Vector3d sd_enu(std::sqrt(r.cov_p_n(1, 1)), std::sqrt(r.cov_p_n(0, 0)), std::sqrt(r.cov_p_n(2, 2)));
+        sol.points.push_back({r.time, r.p_e, sd_enu});
+      }
       auto ev = eval::compare(sol, ref->trajectory, eval::CompareOptions{});
       if (!ev) return make_error("evaluation against " + c.reference.file + ": " + ev.error().message);
       CompareArgs args;
@@ -314,7 +318,8 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
         return ok.error();
       }
       j[key] = {{"horizontal_rms_m", ev->horizontal_rms_m}, {"horizontal_max_m", ev->horizontal_max_m},
-                {"availability_pct", ev->availability_pct}, {"lt5_pct", ev->bins_pct[0]}};
+                {"availability_pct", ev->availability_pct}, {"lt5_pct", ev->bins_pct[0]},
+                {"inside_3sigma_pct", eval::consistency_statistics(ev->errors).inside_3sigma_pct}};
       spdlog::info("{} vs reference: horizontal RMS {:.2f} m, p95 {:.2f} m, max {:.2f} m, {:.1f} % < 5 m", what,
                    ev->horizontal_rms_m, ev->horizontal_p95_m, ev->horizontal_max_m, ev->bins_pct[0]);
       return {};

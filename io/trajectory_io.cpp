@@ -47,7 +47,8 @@ bool to_double(const std::string& s, double& v) {
 }
 
 // Append a point, dropping repeated times (counted) and rejecting backwards time with file:line.
-Expected<void> push_point(TrajectoryFile& f, const std::string& path, int line, GpsTime t, const Eigen::Vector3d& p) {
+Expected<void> push_point(TrajectoryFile& f, const std::string& path, int line, GpsTime t, const Eigen::Vector3d& p,
+                          const Eigen::Vector3d& sd_enu_m = Eigen::Vector3d::Constant(std::nan(""))) {
   auto& pts = f.trajectory.points;
   if (!pts.empty()) {
     if (t == pts.back().t) {
@@ -59,7 +60,7 @@ Expected<void> push_point(TrajectoryFile& f, const std::string& path, int line, 
                                     pts.back().t.to_string()));
     }
   }
-  pts.push_back({t, p});
+  pts.push_back({t, p, sd_enu_m});
   return {};
 }
 
@@ -291,6 +292,8 @@ Expected<TrajectoryFile> read_trajectory_csv(const std::string& path) {
     return make_error(path + ":1: header lacks position columns (expected lat_deg, lon_deg, h_m or x_m, y_m, z_m or e_m, n_m, u_m)");
   }
   f.trajectory.frame = kind == 2 ? eval::Frame::kLocalEnu : eval::Frame::kEcef;
+  // The solution's own σ (pednav solution.csv / smoothed.csv): optional, empty cells = unknown.
+  const int c_sd[3] = {find({"sd_e_m"}), find({"sd_n_m"}), find({"sd_d_m"})};
   int n = 1;
   while (std::getline(in, line)) {
     ++n;
@@ -328,7 +331,12 @@ Expected<TrajectoryFile> read_trajectory_csv(const std::string& path) {
     Eigen::Vector3d p;
     if (kind == 0) p = ecef_from_geodetic({v[0] * kDegToRad, v[1] * kDegToRad, v[2]});
     else p = Eigen::Vector3d(v[0], v[1], v[2]);
-    if (auto r = push_point(f, path, n, GpsTime::from_week_tow(static_cast<int>(week), tow), p); !r) return r.error();
+    Eigen::Vector3d sd = Eigen::Vector3d::Constant(std::nan(""));
+    for (int j = 0; j < 3; ++j) {
+      double x = 0.0;
+      if (c_sd[j] >= 0 && !trim(cell(c_sd[j])).empty() && to_double(cell(c_sd[j]), x) && std::isfinite(x) && x >= 0.0) sd(j) = x;
+    }
+    if (auto r = push_point(f, path, n, GpsTime::from_week_tow(static_cast<int>(week), tow), p, sd); !r) return r.error();
   }
   if (f.trajectory.points.empty()) return make_error(path + ": no rows with a position");
   return f;

@@ -135,5 +135,30 @@ TEST(Statistics, SegmentsAndVertical) {
   EXPECT_NEAR(v.max_abs_m, 0.5, kTol_m);
 }
 
+// Consistency of the solution's own σ (evaluation.json "consistency"): known normalized errors.
+TEST(Statistics, ConsistencyOfTheSolutionSigma) {
+  std::vector<EpochError> e;
+  // 10 epochs with σ_E = 2, σ_N = 1, σ_U = 0.5 and normalized errors (q_E, q_N) = (1, 1) x 8, (4, 0), (0, -3.5);
+  // vertical errors 0.5 (1σ) x 9 and 2.0 (4σ); one epoch without σ (ignored).
+  for (int i = 0; i < 11; ++i) {
+    EpochError x;
+    x.t = kT0.plus_s(i);
+    double qe = 1.0, qn = 1.0;
+    if (i == 8) qe = 4.0, qn = 0.0;
+    if (i == 9) qe = 0.0, qn = -3.5;
+    x.sd_enu_m = Eigen::Vector3d(2.0, 1.0, 0.5);
+    x.d_enu = Eigen::Vector3d(qe * 2.0, qn * 1.0, i == 0 ? 2.0 : 0.5);
+    if (i == 10) x.sd_enu_m.setConstant(std::nan(""));
+    e.push_back(x);
+  }
+  const ConsistencyStats c = consistency_statistics(e);
+  EXPECT_EQ(c.epochs, 10);
+  EXPECT_NEAR(c.inside_3sigma_pct, 80.0, kTol_m);
+  EXPECT_NEAR(c.inside_3sigma_vertical_pct, 90.0, kTol_m);
+  EXPECT_NEAR(c.mean_normalized_sq_horizontal, (8 * 2.0 + 16.0 + 12.25) / 10.0, kTol_m);
+  EXPECT_NEAR(c.max_normalized_horizontal, 4.0, kTol_m);
+  EXPECT_EQ(consistency_statistics({}).epochs, 0);
+}
+
 }  // namespace
 }  // namespace pednav::eval

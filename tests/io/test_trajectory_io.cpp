@@ -1,6 +1,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 
@@ -112,6 +113,21 @@ TEST(CsvReader, PednavColumnsEcefAndLocal) {
   auto g = read_trajectory(b, {});
   ASSERT_TRUE(g) << g.error().message;
   EXPECT_EQ(g->trajectory.frame, eval::Frame::kLocalEnu);
+}
+
+TEST(CsvReader, SolutionSigmasAreReadWhenPresent) {
+  const std::string a = write_temp("pednav_sigma.csv",
+                                   "gps_week,gps_tow_s,lat_deg,lon_deg,h_m,sd_n_m,sd_e_m,sd_d_m\n"
+                                   "2021,400000.0,53.28,-9.06,60.0,0.5,0.25,1.5\n"
+                                   "2021,400001.0,53.28,-9.06,60.0,,,\n");
+  auto f = read_trajectory(a, {});
+  ASSERT_TRUE(f) << f.error().message;
+  ASSERT_EQ(f->trajectory.points.size(), 2u);
+  const Eigen::Vector3d sd = f->trajectory.points[0].sd_enu_m;  // E, N, U
+  EXPECT_DOUBLE_EQ(sd.x(), 0.25);
+  EXPECT_DOUBLE_EQ(sd.y(), 0.5);
+  EXPECT_DOUBLE_EQ(sd.z(), 1.5);
+  EXPECT_TRUE(std::isnan(f->trajectory.points[1].sd_enu_m.x()));  // empty cells: unknown
 }
 
 TEST(CsvReader, BadInputsNameFileAndLine) {

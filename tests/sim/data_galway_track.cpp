@@ -3,6 +3,7 @@
 // on the REAL rover/base/nav files with the GGA track as reference.
 #include <gtest/gtest.h>
 
+#include "eval/statistics.hpp"
 #include "eval/trajectory.hpp"
 #include "core/geodesy.hpp"
 #include "fusion/engine.hpp"
@@ -88,27 +89,22 @@ TEST(GalwayTrack, TightlyCoupledOnTheRealGnssAgainstRtkFixed) {
   ASSERT_TRUE(ref && foot);
   auto as_trajectory = [](const std::vector<fusion::EpochOutput>& epochs) {
     eval::Trajectory t;
-    for (const auto& e : epochs) t.points.push_back({e.t, e.nav.p_eb_e});
+    for (const auto& e : epochs) {
+      const Eigen::Vector3d sd_enu(std::sqrt(e.cov_p_n(1, 1)), std::sqrt(e.cov_p_n(0, 0)), std::sqrt(e.cov_p_n(2, 2)));
+      t.points.push_back({e.t, e.nav.p_eb_e, sd_enu});
+    }
     return t;
   };
   auto fwd = eval::compare(as_trajectory(r->epochs), ref->trajectory, {});
   auto smo = eval::compare(as_trajectory(r->smoothed), ref->trajectory, {});
   ASSERT_TRUE(fwd && smo);
-  // 3σ share against the foot truth (100 Hz, the 1 Hz epochs fall on its samples).
+  // 3σ share against the foot truth (100 Hz; the 1 Hz epochs fall on its samples).
   auto inside3_pct = [&](const std::vector<fusion::EpochOutput>& epochs) {
-    const auto& pts = foot->trajectory.points;
-    long n = 0, inside = 0;
-    size_t k = 0;
-    for (const auto& e : epochs) {
-      while (k + 1 < pts.size() && pts[k].t < e.t) ++k;
-      if (std::abs(pts[k].t - e.t) > 1e-3) continue;
-      const Eigen::Vector3d d = enu_from_ecef(e.nav.p_eb_e, pts[k].p);
-      const double sn = std::sqrt(e.cov_p_n(0, 0)), se = std::sqrt(e.cov_p_n(1, 1));
-      inside += std::abs(d.y()) <= 3.0 * sn && std::abs(d.x()) <= 3.0 * se;
-      ++n;
-    }
-    EXPECT_GT(n, 1000);
-    return 100.0 * static_cast<double>(inside) / static_cast<double>(std::max(1L, n));
+    auto ev = eval::compare(as_trajectory(epochs), foot->trajectory, {});
+    EXPECT_TRUE(ev.has_value());
+    const eval::ConsistencyStats c = ev ? eval::consistency_statistics(ev->errors) : eval::ConsistencyStats{};
+    EXPECT_GT(c.epochs, 1000);
+    return c.inside_3sigma_pct;
   };
   const double in_f = inside3_pct(r->epochs), in_s = inside3_pct(r->smoothed);
   std::printf("galway_track tc vs RTK-fixed GGA: forward %d epochs, RMS %.2f m, max %.2f m, availability %.1f %%; "
