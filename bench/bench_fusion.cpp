@@ -114,26 +114,35 @@ void BM_CovariancePropagationOnly17(benchmark::State& st) {
 BENCHMARK(BM_CovariancePropagationOnly17);
 
 // ZUPT form D (3 rows) + ZARU (3 rows) Joseph update on 17 states, as the engine's stance epochs.
+using H6 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, ins::kMaxErrorDim>;
+using R6 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, 6>;
+using V6 = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 6, 1>;
+
+// The 6 rows of a stance update (form-D ZUPT at foot velocity v + ZARU) for an n-state layout: H, residual, R.
+void zupt_rows(int n, const Eigen::Vector3d& v, H6& H, V6& r, R6& R) {
+  H = H6::Zero(6, n);
+  const Eigen::Matrix<double, 3, 6> J = fusion::zupt_jacobian(v, fusion::ZuptForm::kDynamic);
+  H.block<3, 3>(0, ins::kVel.offset) = J.leftCols<3>();
+  H.block<3, 3>(0, ins::kAtt.offset) = J.rightCols<3>();
+  H.block<3, 3>(3, ins::kBiasGyro.offset).setIdentity();
+  r.resize(6);
+  r << -v, 1e-4, -2e-4, 5e-5;
+  R = R6::Zero(6, 6);
+  R.diagonal() << 4e-4, 4e-4, 4e-4, 1e-4, 1e-4, 1e-4;
+}
+
 void BM_ZuptUpdate(benchmark::State& st) {
   const int n = 17;
   const ErrorMatrix P0 = random_spd(n, 4u);
   ErrorMatrix P = P0, tmp;
   ErrorVector dx;
-  using H6 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, ins::kMaxErrorDim>;
-  using R6 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, 6>;
-  using V6 = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 6, 1>;
   const Eigen::Vector3d v(0.01, -0.02, 0.005);
   AllocCounter allocs;
   for (auto _ : st) {
-    H6 H = H6::Zero(6, n);
-    const Eigen::Matrix<double, 3, 6> J = fusion::zupt_jacobian(v, fusion::ZuptForm::kDynamic);
-    H.block<3, 3>(0, ins::kVel.offset) = J.leftCols<3>();
-    H.block<3, 3>(0, ins::kAtt.offset) = J.rightCols<3>();
-    H.block<3, 3>(3, ins::kBiasGyro.offset).setIdentity();
-    V6 r(6);
-    r << -v, 1e-4, -2e-4, 5e-5;
-    R6 R = R6::Zero(6, 6);
-    R.diagonal() << 4e-4, 4e-4, 4e-4, 1e-4, 1e-4, 1e-4;
+    H6 H;
+    V6 r;
+    R6 R;
+    zupt_rows(n, v, H, r, R);
     P = P0;
     benchmark::DoNotOptimize(fusion::joseph_update(P, H, r, R, dx, tmp));
     benchmark::DoNotOptimize(dx.data());
@@ -263,20 +272,12 @@ void BM_SmootherIntervalStep(benchmark::State& st) {
   ColumnSparse<ins::kMaxErrorDim> Phi;
   Phi.assign(model.Phi);
   const ErrorMatrix P = random_spd(n, 4u);
-  using H6 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, ins::kMaxErrorDim>;
-  using R6 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, 6>;
-  using V6 = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 6, 1>;
   using K6 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, ins::kMaxErrorDim, 6>;
   const Eigen::Vector3d v(0.01, -0.02, 0.005);
-  H6 H = H6::Zero(6, n);
-  const Eigen::Matrix<double, 3, 6> J = fusion::zupt_jacobian(v, fusion::ZuptForm::kDynamic);
-  H.block<3, 3>(0, ins::kVel.offset) = J.leftCols<3>();
-  H.block<3, 3>(0, ins::kAtt.offset) = J.rightCols<3>();
-  H.block<3, 3>(3, ins::kBiasGyro.offset).setIdentity();
-  V6 r(6);
-  r << -v, 1e-4, -2e-4, 5e-5;
-  R6 S = R6::Zero(6, 6);
-  S.diagonal() << 4e-4, 4e-4, 4e-4, 1e-4, 1e-4, 1e-4;
+  H6 H;
+  V6 r;
+  R6 S;
+  zupt_rows(n, v, H, r, S);
   S.noalias() += H * P * H.transpose();
   const Eigen::LDLT<R6> ldlt(S);
   const K6 K = ldlt.solve(H * P).transpose();

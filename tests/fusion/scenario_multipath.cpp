@@ -17,6 +17,7 @@
 #include "io/run_command.hpp"
 #include "io/scenario_config.hpp"
 #include "sim/simulator.hpp"
+#include "tests/sim/fixtures.hpp"
 
 namespace pednav {
 namespace {
@@ -84,14 +85,7 @@ fusion::EngineOptions options(const sim::Simulation& s, bool states) {
   return o;
 }
 
-fusion::EngineInputs inputs(const sim::Simulation& s) {
-  fusion::EngineInputs in;
-  in.imu = &s.imu;
-  in.nav = &s.nav;
-  in.rover = &s.gnss.rover.epochs;
-  in.base = &s.gnss.base.epochs;
-  return in;
-}
+fusion::EngineInputs inputs(const sim::Simulation& s) { return test::engine_inputs(s); }
 
 // Sum of the horizontal NEES e_hᵀ P_h⁻¹ e_h over the epochs of the static window, and their count.
 std::pair<double, int> static_nees(const sim::Simulation& s, const fusion::EngineResult& r) {

@@ -62,11 +62,7 @@ class ForestWalkTc : public ::testing::Test {
     ASSERT_TRUE(s.has_value()) << s.error().message;
     g_run = new TcRun{std::move(*s), {}, 0.0};
     // The configuration `pednav simulate` writes, with mode tc: defaults of io::RunConfig.
-    io::RunConfig c;
-    c.mode = "tc";
-    c.imu.spec = file->scenario.imu.spec;
-    fusion::EngineOptions o = io::engine_options(c);
-    o.base_position_e = g_run->sim.gnss.p_base_e;
+    fusion::EngineOptions o = test::tc_default_options(*file, g_run->sim);
     o.record_gnss_rows = true;  // per-measurement w-test records for the fault-rejection test
     const fusion::EngineInputs in = test::engine_inputs(g_run->sim);
     const auto t0 = std::chrono::steady_clock::now();
@@ -229,12 +225,7 @@ TEST(ForestWalkTcHeading, StaticStartGnssNoiseDoesNotEndTheHeadingFit) {
   file->scenario.seed = 24;
   auto s = sim::simulate(file->scenario);
   ASSERT_TRUE(s.has_value()) << s.error().message;
-  io::RunConfig c;
-  c.mode = "tc";
-  c.imu.spec = file->scenario.imu.spec;
-  fusion::EngineOptions o = io::engine_options(c);
-  o.base_position_e = s->gnss.p_base_e;
-  auto r = fusion::run_forward(test::engine_inputs(*s), o);
+  auto r = fusion::run_forward(test::engine_inputs(*s), test::tc_default_options(*file, *s));
   ASSERT_TRUE(r.has_value()) << r.error().message;
   const auto& sum = r->summary;
   std::printf("[ forest ] seed 24: %s\n", sum.initialization.c_str());
@@ -285,12 +276,7 @@ gnss: {base_offset_enu_m: [50, 20, 0]}
   ASSERT_TRUE(file.has_value()) << file.error().message;
   auto s = sim::simulate(file->scenario);
   ASSERT_TRUE(s.has_value()) << s.error().message;
-  io::RunConfig c;
-  c.mode = "tc";
-  c.imu.spec = file->scenario.imu.spec;
-  fusion::EngineOptions o = io::engine_options(c);
-  o.base_position_e = s->gnss.p_base_e;
-  auto r = fusion::run_forward(test::engine_inputs(*s), o);
+  auto r = fusion::run_forward(test::engine_inputs(*s), test::tc_default_options(*file, *s));
   ASSERT_FALSE(r.has_value());
   EXPECT_NE(r.error().message.find("cannot find the initial heading from motion: the INS/ZUPT track goes"),
             std::string::npos)

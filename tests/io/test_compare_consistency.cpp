@@ -37,15 +37,20 @@ void write_files(const std::string& dir) {
   }
 }
 
-TEST(CompareConsistency, SolutionSigmaIsScored) {
-  const std::string dir = temp_dir("consistency");
-  write_files(dir);
+// The comparison of the two files in `dir` into dir/out, without plots.
+CompareArgs compare_args(const std::string& dir) {
   CompareArgs a;
   a.solution = dir + "/solution.csv";
   a.reference = dir + "/ref.csv";
   a.out_dir = dir + "/out";
   a.plots = false;
-  auto ev = run_compare(a);
+  return a;
+}
+
+TEST(CompareConsistency, SolutionSigmaIsScored) {
+  const std::string dir = temp_dir("consistency");
+  write_files(dir);
+  auto ev = run_compare(compare_args(dir));
   ASSERT_TRUE(ev) << ev.error().message;
   std::ifstream in(dir + "/out/evaluation.json");
   const auto j = nlohmann::json::parse(in);
@@ -61,11 +66,7 @@ TEST(CompareConsistency, SolutionSigmaIsScored) {
 TEST(CompareConsistency, NoConsistencyBlockAfterARotatingAlignment) {
   const std::string dir = temp_dir("consistency_aligned");
   write_files(dir);
-  CompareArgs a;
-  a.solution = dir + "/solution.csv";
-  a.reference = dir + "/ref.csv";
-  a.out_dir = dir + "/out";
-  a.plots = false;
+  CompareArgs a = compare_args(dir);
   a.compare.align = eval::Align::kStart;
   ASSERT_TRUE(run_compare(a));
   std::ifstream in(dir + "/out/evaluation.json");

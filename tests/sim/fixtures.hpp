@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "fusion/engine.hpp"
+#include "io/config.hpp"
+#include "io/run_command.hpp"
 #include "io/scenario_config.hpp"
 #include "sim/simulator.hpp"
 
@@ -83,6 +85,17 @@ inline fusion::EngineInputs engine_inputs(const sim::Simulation& s) {
   in.rover = &s.gnss.rover.epochs;
   in.base = &s.gnss.base.epochs;
   return in;
+}
+
+/// `pednav run`'s defaults in mode tc for a simulated scenario (the configuration `pednav simulate` writes, with
+/// mode tc): IMU spec of the scenario, base position of the simulation.
+inline fusion::EngineOptions tc_default_options(const io::ScenarioFile& file, const sim::Simulation& s) {
+  io::RunConfig c;
+  c.mode = "tc";
+  c.imu.spec = file.scenario.imu.spec;
+  fusion::EngineOptions o = io::engine_options(c);
+  o.base_position_e = s.gnss.p_base_e;
+  return o;
 }
 
 /// A fresh empty temporary folder.
