@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <type_traits>
 
@@ -370,10 +371,12 @@ double median(std::vector<double>& v) {
 struct PassOptions {
   bool gnss = true;
   std::optional<GpsTime> stop;
-  /// Stop once the IMU has walked this far: horizontal path length of the nominal position over the samples the
-  /// detector does not flag as stance (ZUPT corrections at rest do not count). The heading pass: the distance walked
-  /// does not depend on the unknown heading.
-  std::optional<double> stop_walked_m;
+  /// The heading pass: each time the IMU has walked the next milestone (walked_milestone_m, then twice that, …) —
+  /// horizontal path length of the nominal position over the samples the detector does not flag as stance, so ZUPT
+  /// corrections at rest do not count and the distance does not depend on the unknown heading — at_milestone(the
+  /// outputs so far, the milestone) is called; the pass stops when it returns true.
+  double walked_milestone_m = 0.0;
+  std::function<bool(const EngineResult&, double)> at_milestone;
 };
 
 class Runner {
@@ -483,6 +486,7 @@ class Runner {
     size_t sample_index = start;
     int last_used = 0, last_rejected = 0;
     bool failed = false;
+    int64_t last_covariance_check_ns = std::numeric_limits<int64_t>::min() / 2;
     bool prev_stance = false;  // stance at the previous mechanization epoch (= this interval's start)
     std::optional<StepTracker> steps;  // seed 000 step-velocity aiding (fusion/step_velocity.hpp)
     if (o_.step_velocity.enabled) steps.emplace(o_.step_velocity);
@@ -518,7 +522,11 @@ class Runner {
       prev_stance = stance;
       std::string why;
       const bool output_now = inc.t1.ns() >= next_out_ns;
-      if (!f.healthy(why, output_now) || implausible_streak_ >= kImplausibleEpochs) {
+      // The symmetry / PSD test (an LDLT) at output epochs, at most once per second (outputs at the mechanization
+      // rate, as in the heading pass, would otherwise pay it every step); finiteness and variances every step.
+      const bool check_covariance = output_now && inc.t1.ns() - last_covariance_check_ns >= kNsPerS;
+      if (check_covariance) last_covariance_check_ns = inc.t1.ns();
+      if (!f.healthy(why, check_covariance) || implausible_streak_ >= kImplausibleEpochs) {
         if (why.empty()) {
           why = "innovations implausible: " + std::to_string(implausible_streak_) +
                 " consecutive GNSS epochs with most code measurements rejected";
@@ -556,19 +564,22 @@ class Runner {
 
     const Vector3d up_start_e = nav0.p_eb_e.normalized();
     Vector3d p_last_e = nav0.p_eb_e;
-    double walked_m = 0.0;
-    auto walked_enough = [&] {
+    double walked_m = 0.0, milestone_m = po.walked_milestone_m;
+    auto stop_walking = [&] {
       const Vector3d d = f.x().nav.p_eb_e - p_last_e;
       p_last_e = f.x().nav.p_eb_e;
       if (!decisions_[std::min(sample_index, decisions_.size() - 1)].stance) {
         walked_m += (d - d.dot(up_start_e) * up_start_e).norm();
       }
-      return walked_m >= *po.stop_walked_m;
+      if (walked_m < milestone_m) return false;
+      const double reached = milestone_m;
+      milestone_m *= 2.0;
+      return po.at_milestone(result, reached);
     };
     for (; sample_index < samples.size(); ++sample_index) {
       const ins::ImuSample& raw = samples[sample_index];
       if (po.stop && raw.t > *po.stop) break;
-      if (po.stop_walked_m && walked_enough()) break;
+      if (po.at_milestone && milestone_m > 0.0 && stop_walking()) break;
       if (!raw.omega_ib_b.allFinite() || !raw.f_ib_b.allFinite()) {
         count(sum.imu_rejected, "non_finite");
         continue;
@@ -1207,24 +1218,16 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
     size_t next_g = 0;
     Vector3d prev = p0;
     Vector3d first = Vector3d::Zero();
-    double distance_m = o.heading_init_distance_m, theta = 0.0, rms = 0.0, sigma_yaw = 0.0;
+    double distance_m = 0.0, theta = 0.0, rms = 0.0, sigma_yaw = 0.0, extent_m = 0.0;
     size_t n_fit = 0;
+    int fits = 0;
     GpsTime stop;
-    for (int attempt = 0;; ++attempt) {
-      EngineResult pass1;
-      PassOptions p1;
-      p1.gnss = false;
-      p1.stop_walked_m = distance_m;
-      Runner r1(in, ins_only, decisions);
-      if (auto ok = r1.run(s0, ins::nav_state_at_rest(samples[s0].t, p0, level->roll, level->pitch, 0.0), imu0, p1, pass1);
-          !ok) {
-        return make_error("heading initialization pass: " + ok.error().message);
-      }
-      if (pass1.epochs.empty()) return make_error("heading initialization pass: no output epoch");
+    // The fit over the pass-1 outputs so far; false if the track is too short to fit (extent < 10 m or < 5 points).
+    auto fit_so_far = [&](const EngineResult& pass1) {
       stop = pass1.epochs.back().t;
       // Largest horizontal distance of the track from its start (the fit needs extent; a loop returns near its start).
       const Vector3d p_beg = pass1.epochs.front().nav.p_eb_e, up = p_beg.normalized();
-      double extent_m = 0.0;
+      extent_m = 0.0;
       for (const auto& e : pass1.epochs) {
         const Vector3d d = e.nav.p_eb_e - p_beg;
         extent_m = std::max(extent_m, (d - d.dot(up) * up).norm());
@@ -1246,16 +1249,7 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
         src.push_back(enu_from_ecef(p_imu + runner.lever_e(p_imu), first));
         dst.push_back(enu_from_ecef(pa, first));
       }
-      const bool walk_goes_on = stop < samples.back().t;  // pass 1 stopped at the distance, not at the end of data
-      if (src.size() < 5 || extent_m < 10.0) {
-        if (walk_goes_on && attempt < kHeadingInitDoublings) {  // e.g. shuffling on the spot before the walk
-          distance_m *= 2.0;
-          continue;
-        }
-        return make_error(fmt_message("cannot find the initial heading from motion: the INS/ZUPT track goes %.1f m from its start "
-                                      "(at least 10 m with 5 GNSS epoch solutions needed); set initial.yaw_deg",
-                                      extent_m));
-      }
+      if (src.size() < 5 || extent_m < 10.0) return false;
       std::tie(theta, rms) = fit_yaw(src, dst);
       double spread2 = 0;
       Vector3d mean = Vector3d::Zero();
@@ -1264,8 +1258,36 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
       for (const auto& p : src) spread2 += (p - mean).head<2>().squaredNorm();
       sigma_yaw = std::clamp(2.0 * rms / std::sqrt(std::max(spread2, 1.0)), 1.0 * kDegToRad, 30.0 * kDegToRad);
       n_fit = src.size();
-      if (sigma_yaw <= kHeadingInitTargetSigma || !walk_goes_on || attempt == kHeadingInitDoublings) break;
-      distance_m *= 2.0;
+      return true;
+    };
+    // One pass: at every milestone D, 2D, 4D, … fit what has been walked; stop at a fit with σ_yaw <= target, or at
+    // the last milestone. No milestone reached (the data end first): fit whatever was walked.
+    bool fitted = false;
+    PassOptions p1;
+    p1.gnss = false;
+    p1.walked_milestone_m = o.heading_init_distance_m;
+    p1.at_milestone = [&](const EngineResult& so_far, double milestone_m) {
+      if (so_far.epochs.empty()) return false;
+      distance_m = milestone_m;
+      ++fits;
+      fitted = fit_so_far(so_far);
+      return (fitted && sigma_yaw <= kHeadingInitTargetSigma) || fits > kHeadingInitDoublings;
+    };
+    EngineResult pass1;
+    Runner r1(in, ins_only, decisions);
+    if (auto ok = r1.run(s0, ins::nav_state_at_rest(samples[s0].t, p0, level->roll, level->pitch, 0.0), imu0, p1, pass1);
+        !ok) {
+      return make_error("heading initialization pass: " + ok.error().message);
+    }
+    if (pass1.epochs.empty()) return make_error("heading initialization pass: no output epoch");
+    if (pass1.epochs.back().t > stop) {  // the data ended before the last milestone: fit the whole pass
+      distance_m = std::max(distance_m, o.heading_init_distance_m);
+      fitted = fit_so_far(pass1);
+    }
+    if (!fitted) {
+      return make_error(fmt_message("cannot find the initial heading from motion: the INS/ZUPT track goes %.1f m from its start "
+                                    "(at least 10 m with 5 GNSS epoch solutions needed); set initial.yaw_deg",
+                                    extent_m));
     }
     yaw0 = wrap_pi(-theta);  // ENU rotation counter-clockwise by theta = heading change of -theta
     opt.initial_sigma_yaw_rad = sigma_yaw;
