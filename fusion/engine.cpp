@@ -1202,11 +1202,11 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
     yaw0 = *o.initial_yaw_rad;
     how += "; heading from configuration";
   } else if (tc) {
-    // Pass 1 (docs/fusion.md §8): the INS/ZUPT track with yaw 0 until it has walked D from the start (the walked
-    // distance does not depend on the heading; a GNSS track can "move" D while the person stands, by noise and
-    // blunders), then a 2D fit of that track onto the GNSS epoch solutions over the same span. While the track is
-    // less than 10 m from its start or the fit's σ_yaw is above kHeadingInitTargetSigma, and the walk goes on, D
-    // doubles (at most kHeadingInitDoublings times).
+    // Pass 1 (docs/fusion.md §8): the INS/ZUPT track with yaw 0, and at each milestone D, 2D, 4D, … of distance
+    // walked (which does not depend on the heading; a GNSS track can "move" D while the person stands, by noise and
+    // blunders) a 2D fit of that track onto the GNSS epoch solutions over the same span. The pass stops at the first
+    // fit with σ_yaw <= kHeadingInitTargetSigma on a track >= 10 m from its start, or after kHeadingInitDoublings
+    // further milestones.
     constexpr double kHeadingInitTargetSigma = 3.0 * kDegToRad;
     constexpr int kHeadingInitDoublings = 5;  // up to 32 D
     EngineOptions ins_only = o;

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "core/geodesy.hpp"
@@ -26,6 +27,15 @@ const char* align_name(eval::Align a) {
     case eval::Align::kBestFit3d: return "best-fit-3d";
     default: return "none";
   }
+}
+
+// Consistency of the solution's own σ (pednav CSV solutions carry it), in its own axes: none after a rotating
+// alignment or without σ.
+std::optional<eval::ConsistencyStats> consistency_of(const eval::Evaluation& ev, const CompareArgs& args) {
+  if (args.compare.align != eval::Align::kNone) return std::nullopt;
+  const eval::ConsistencyStats cs = eval::consistency_statistics(ev.errors);
+  if (cs.epochs == 0) return std::nullopt;
+  return cs;
 }
 
 // trajectory_en.svg, error_vs_time.svg (+-3 sigma when the solution is a pednav CSV with sd_n_m/sd_e_m),
@@ -95,17 +105,12 @@ std::string evaluation_json(const eval::Evaluation& ev, const CompareArgs& args,
     j["closure_pct_of_distance"] = ev.closure_pct_of_distance;
     j["distance_m"] = ev.distance_m;
   }
-  // Consistency of the solution's own σ (pednav CSV solutions carry it), in its own axes: not after a rotating
-  // alignment.
-  if (args.compare.align == eval::Align::kNone) {
-    const eval::ConsistencyStats cs = eval::consistency_statistics(ev.errors);
-    if (cs.epochs > 0) {
-      j["consistency"] = {{"epochs_with_sigma", cs.epochs},
-                          {"inside_3sigma_pct", cs.inside_3sigma_pct},
-                          {"inside_3sigma_vertical_pct", cs.inside_3sigma_vertical_pct},
-                          {"mean_normalized_sq_horizontal", cs.mean_normalized_sq_horizontal},
-                          {"max_normalized_horizontal", cs.max_normalized_horizontal}};
-    }
+  if (const auto cs = consistency_of(ev, args)) {
+    j["consistency"] = {{"epochs_with_sigma", cs->epochs},
+                        {"inside_3sigma_pct", cs->inside_3sigma_pct},
+                        {"inside_3sigma_vertical_pct", cs->inside_3sigma_vertical_pct},
+                        {"mean_normalized_sq_horizontal", cs->mean_normalized_sq_horizontal},
+                        {"max_normalized_horizontal", cs->max_normalized_horizontal}};
   }
   const eval::VerticalStats v = eval::vertical_statistics(ev.errors);
   j["vertical"] = {{"rms_m", v.rms_m}, {"mean_m", v.mean_m}, {"std_m", v.std_m}, {"p95_abs_m", v.p95_abs_m},
@@ -146,14 +151,11 @@ std::string evaluation_markdown(const eval::Evaluation& ev, const CompareArgs& a
     s += fmt::format("| closure | {:.3f} m ({:.2f} % of {:.1f} m) |\n", ev.closure_m, ev.closure_pct_of_distance,
                      ev.distance_m);
   }
-  if (args.compare.align == eval::Align::kNone) {
-    const eval::ConsistencyStats cs = eval::consistency_statistics(ev.errors);
-    if (cs.epochs > 0) {
-      s += fmt::format("| inside 3σ (N and E / U, the solution's own σ) | {:.1f} % / {:.1f} % of {} epochs |\n"
-                       "| mean (e_E/σ_E)² + (e_N/σ_N)² (2 if consistent) / max \\|e\\|/σ | {:.2f} / {:.1f} |\n",
-                       cs.inside_3sigma_pct, cs.inside_3sigma_vertical_pct, cs.epochs, cs.mean_normalized_sq_horizontal,
-                       cs.max_normalized_horizontal);
-    }
+  if (const auto cs = consistency_of(ev, args)) {
+    s += fmt::format("| inside 3σ (N and E / U, the solution's own σ) | {:.1f} % / {:.1f} % of {} epochs |\n"
+                     "| mean (e_E/σ_E)² + (e_N/σ_N)² (2 if consistent) / max \\|e\\|/σ | {:.2f} / {:.1f} |\n",
+                     cs->inside_3sigma_pct, cs->inside_3sigma_vertical_pct, cs->epochs, cs->mean_normalized_sq_horizontal,
+                     cs->max_normalized_horizontal);
   }
   const eval::VerticalStats v = eval::vertical_statistics(ev.errors);
   s += fmt::format("| vertical mean / sd | {:.3f} m / {:.3f} m |\n| vertical p95 abs / max abs | {:.3f} m / {:.3f} m |\n",
