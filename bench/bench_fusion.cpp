@@ -78,23 +78,27 @@ ins::ImuIncrement increment() {
 // Covariance prediction of one mechanization step as the engine does it: the discrete error model of the interval
 // (F, G, Q → Φ, Q_d) and P ← Φ P Φᵀ + Q_d.
 void BM_CovariancePrediction17(benchmark::State& st) {
-  const ins::ErrorStateLayout layout = layout17();
+  ins::ErrorStateLayout layout = layout17();
+  if (st.range(0) > layout.dim()) (void)layout.add("multipath", static_cast<int>(st.range(0)) - layout.dim());
   const auto spec = *ins::imu_spec_preset("crista");
   const ins::NavState a = ins::nav_state_at_rest(GpsTime(), ecef_from_geodetic({0.9, -2.0, 1000.0}), 0.1, 0.2, 0.3);
   const ins::ImuIncrement inc = increment();
   const ins::NavState b = ins::mechanize(a, inc);
   ErrorMatrix P = random_spd(layout.dim(), 1u), tmp;
   const ErrorMatrix P0 = P;
+  ColumnSparse<ins::kMaxErrorDim> Phi;
   AllocCounter allocs;
   for (auto _ : st) {
     const ins::DiscreteErrorModel m = ins::interval_error_model(layout, spec, a, b, inc);
-    fusion::covariance_predict(P, m.Phi, m.Qd, tmp);
+    Phi.assign(m.Phi);  // as the engine: Φ by its non-zeros
+    fusion::covariance_predict(P, Phi, m.Qd, tmp);
     if (P(0, 0) > 1e6) P = P0;
     benchmark::DoNotOptimize(P.data());
   }
   allocs.report(st);
 }
-BENCHMARK(BM_CovariancePrediction17);
+// The argument is n; 29 = 17 + 12 code-multipath states (the default, docs/consistency.md §3.1).
+BENCHMARK(BM_CovariancePrediction17)->Arg(17)->Arg(29);
 
 // P ← Φ P Φᵀ + Q_d alone (17 states).
 void BM_CovariancePropagationOnly17(benchmark::State& st) {
@@ -132,7 +136,7 @@ void zupt_rows(int n, const Eigen::Vector3d& v, H6& H, V6& r, R6& R) {
 }
 
 void BM_ZuptUpdate(benchmark::State& st) {
-  const int n = 17;
+  const int n = static_cast<int>(st.range(0));
   const ErrorMatrix P0 = random_spd(n, 4u);
   ErrorMatrix P = P0, tmp;
   ErrorVector dx;
@@ -149,7 +153,7 @@ void BM_ZuptUpdate(benchmark::State& st) {
   }
   allocs.report(st);
 }
-BENCHMARK(BM_ZuptUpdate);
+BENCHMARK(BM_ZuptUpdate)->Arg(17)->Arg(29);  // 29: + 12 code-multipath states (the default)
 
 // SD pseudorange + SD Doppler update with 10 satellites: satellite states at the rover and base transmit times,
 // the SD models with Jacobians, weights, the w-test (S⁻¹) and the 20-row Joseph update, with the same library
@@ -262,7 +266,8 @@ BENCHMARK(BM_SmootherStep);
 // eq. 12.20) and restarted every 20 iterations (1 Hz output at 20 Hz). Per iteration the counterpart of
 // BM_SmootherStep (which the earlier engine ran at every stance step).
 void BM_SmootherIntervalStep(benchmark::State& st) {
-  const ins::ErrorStateLayout layout = layout17();
+  ins::ErrorStateLayout layout = layout17();
+  if (st.range(0) > layout.dim()) (void)layout.add("multipath", static_cast<int>(st.range(0)) - layout.dim());
   const int n = layout.dim();
   const auto spec = *ins::imu_spec_preset("crista");
   const ins::NavState a = ins::nav_state_at_rest(GpsTime(), ecef_from_geodetic({0.9, -2.0, 1000.0}), 0.1, 0.2, 0.3);
@@ -298,7 +303,7 @@ void BM_SmootherIntervalStep(benchmark::State& st) {
   }
   allocs.report(st);
 }
-BENCHMARK(BM_SmootherIntervalStep);
+BENCHMARK(BM_SmootherIntervalStep)->Arg(17)->Arg(29);
 
 // Reading a RINEX 3.04 observation file (1 Hz, 10 GPS satellites with C1C/D1C/S1C) through the RTKLIB adapter:
 // items/s = epochs per second.

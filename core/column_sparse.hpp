@@ -58,6 +58,18 @@ class ColumnSparse {
     }
   }
 
+  /// The upper triangle of out += X Aᵀ (out square, rows() x rows(); its strict lower triangle is not touched):
+  /// for a product known to be symmetric (Φ P Φᵀ), half the work.
+  template <typename MatX, typename MatOut>
+  void add_times_transposed_upper(const Eigen::MatrixBase<MatX>& X, MatOut& out) const {
+    for (int c = 0; c < cols_; ++c) {
+      for (int k = start_[c]; k < start_[c + 1]; ++k) {
+        const int r = row_[k];
+        out.col(r).head(r + 1) += val_[k] * X.col(c).head(r + 1);
+      }
+    }
+  }
+
  private:
   int rows_ = 0, cols_ = 0;
   std::array<int, kMaxDim + 1> start_;  // not value-initialized: assign() writes what is read (no 12 kB memset)

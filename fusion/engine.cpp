@@ -264,7 +264,10 @@ class Filter {
     P_.middleRows<3>(v) += APa;
     P_.middleCols<3>(v) += APa.transpose();
     P_.block<3, 3>(v, v) += APaaAt;
-    P_ = 0.5 * (P_ + P_.transpose()).eval();
+    // The row and column updates are mirror images of each other, so only the (v, v) block can lose symmetry (by
+    // the rounding of A P_φφ Aᵀ): symmetrize that block (the whole matrix would cost n² per ZUPT).
+    const Eigen::Matrix3d Pvv = P_.block<3, 3>(v, v);
+    P_.block<3, 3>(v, v) = 0.5 * (Pvv + Pvv.transpose());
     // The smoother's cross-covariance follows the coordinate change: Γ ← Γ Jᵀ (docs/fusion.md eq. 12.18).
     if (recording_) interval_.reexpress(v, a, A);
   }

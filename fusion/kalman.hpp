@@ -21,9 +21,19 @@ inline void covariance_predict(ins::ErrorMatrix& P, const ins::ErrorMatrix& Phi,
   P = 0.5 * (P + P.transpose()).eval();
 }
 
+/// Mirror the upper triangle of the square matrix A into its strict lower triangle (exact symmetry).
+template <typename Mat>
+inline void mirror_upper(Mat& A) {
+  const Eigen::Index n = A.rows();
+  for (Eigen::Index j = 0; j < n; ++j) {
+    for (Eigen::Index i = j + 1; i < n; ++i) A(i, j) = A(j, i);
+  }
+}
+
 /// The same with Φ given by its nonzeros (Φ of the INS error model is mostly zeros): P ← Φ P Φᵀ + Q_d; on return
 /// tmp = Φ P (the prior P). Both products are sums of whole columns (contiguous, vectorized): P Φᵀ column by column,
-/// then Φ P = (P Φᵀ)ᵀ as P is symmetric, and Φ P Φᵀ = (Φ P) Φᵀ the same way (docs/performance.md §1).
+/// then Φ P = (P Φᵀ)ᵀ as P is symmetric, and Φ P Φᵀ = (Φ P) Φᵀ the same way, on the upper triangle only (the result
+/// is symmetric), mirrored into the lower one (docs/performance.md §1).
 inline void covariance_predict(ins::ErrorMatrix& P, const ColumnSparse<ins::kMaxErrorDim>& Phi,
                                const ins::ErrorMatrix& Qd, ins::ErrorMatrix& tmp) {
   ins::ErrorMatrix PPhit;
@@ -31,8 +41,8 @@ inline void covariance_predict(ins::ErrorMatrix& P, const ColumnSparse<ins::kMax
   Phi.add_times_transposed(P, PPhit);  // P Φᵀ
   tmp = PPhit.transpose();             // Φ P
   P = Qd;
-  Phi.add_times_transposed(tmp, P);  // Q_d + Φ P Φᵀ
-  P = 0.5 * (P + P.transpose()).eval();
+  Phi.add_times_transposed_upper(tmp, P);  // upper triangle of Q_d + Φ P Φᵀ
+  mirror_upper(P);
 }
 
 /// Joseph-form Kalman update (Groves 2013 eqs. 3.18, 3.22): K = P Hᵀ (H P Hᵀ + R)⁻¹, dx = K r,
@@ -64,21 +74,27 @@ bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR
   SMatrix S = R;
   S.noalias() += H * PHt;
   const Eigen::LDLT<SMatrix> ldlt(S);
-  if (ldlt.info() != Eigen::Success) return false;
+  // Eigen's LDLT reports success for indefinite matrices too: positive definite means every pivot D_ii > 0.
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 0.0).all()) return false;
   const ColsMatrix K = ldlt.solve(PHt.transpose()).transpose();
   dx.noalias() = K * r;
   on_gain(ldlt, K);
-  // (I − K H) P (I − K H)ᵀ without forming I − K H (m ≪ n): T = P − K (H P), then T − (T Hᵀ) Kᵀ; H P = (P Hᵀ)ᵀ
-  // as P is symmetric. Two n×m×n products and two sparse n×n×m ones instead of two n×n×n and one n×m×n.
-  tmp = P;
-  tmp.noalias() -= K * PHt.transpose();
-  ColsMatrix THt;
-  times_Ht(tmp, THt);
-  // T − (T Hᵀ) Kᵀ + K R Kᵀ = T − (T Hᵀ − K R) Kᵀ: one n×m×n product for the last two terms.
-  THt.noalias() -= K * R;
-  P = tmp;
-  P.noalias() -= THt * K.transpose();
-  P = 0.5 * (P + P.transpose()).eval();
+  // Joseph form, expanded (exact for any gain K, so a rounding error in K still enters P only to second order):
+  // (I − K H) P (I − K H)ᵀ + K R Kᵀ = P − K Uᵀ − U Kᵀ + K S Kᵀ with U = P Hᵀ and S = H U + R
+  //                                 = P − K Wᵀ − W Kᵀ with W = U − ½ K S
+  // (docs/fusion.md eq. 4.6): a symmetric rank-2m update, computed on the upper triangle and mirrored — n(n+1)·m
+  // multiply-adds instead of the two n×m×n products of T = P − K H P, T − (T Hᵀ − K R) Kᵀ.
+  ColsMatrix W = PHt;
+  W.noalias() -= 0.5 * (K * S);
+  const Eigen::Index n = P.rows();
+  for (Eigen::Index j = 0; j < n; ++j) {
+    auto Pj = P.col(j).head(j + 1);
+    for (Eigen::Index k = 0; k < K.cols(); ++k) {
+      Pj -= W(j, k) * K.col(k).head(j + 1) + K(j, k) * W.col(k).head(j + 1);
+    }
+  }
+  mirror_upper(P);
+  (void)tmp;
   return true;
 }
 
