@@ -303,7 +303,10 @@ class Filter {
 
   // check_covariance: also the symmetry / positive semi-definiteness test (an LDLT: done at the output epochs only).
   bool healthy(std::string& why, bool check_covariance) const {
-    if (!P_.allFinite() || !x_.nav.p_eb_e.allFinite() || !x_.nav.v_eb_e.allFinite()) {
+    // The sum of P is finite exactly when every entry is (a NaN or ±inf anywhere makes it non-finite), except when
+    // finite entries near 1e308 overflow: then the entry-wise test decides. One vectorized reduction per step.
+    const bool p_finite = std::isfinite(P_.sum()) || P_.allFinite();
+    if (!p_finite || !x_.nav.p_eb_e.allFinite() || !x_.nav.v_eb_e.allFinite()) {
       why = "non-finite state or covariance";
       return false;
     }
@@ -385,7 +388,10 @@ struct PassOptions {
 class Runner {
  public:
   Runner(const EngineInputs& in, const EngineOptions& o, const std::vector<ins::ZuptDecision>& decisions)
-      : in_(in), o_(o), decisions_(decisions) {
+      : in_(in), o_(o), decisions_(decisions),
+        // The w-test threshold depends on the configured probability only: computed once (a bisection on the
+        // incomplete gamma function), not at every GNSS epoch.
+        w_test_threshold_(gnss::chi_square_quantile(o.fault_probability, 1)) {
     if (o.mode == Mode::kTightlyCoupled && in.rover && in.base && o.base_position_e) {
       std::vector<GpsTime> rt, bt;
       for (const auto& e : *in.rover) rt.push_back(e.time);
@@ -950,7 +956,7 @@ class Runner {
     const double svh = o_.antenna_velocity_sigma_horizontal_mps, svv = o_.antenna_velocity_sigma_vertical_mps;
     const Eigen::Matrix3d C_vel = Ren * Vector3d(svh * svh, svh * svh, svv * svv).asDiagonal() * Ren.transpose();
     // w-test fault rejection, worst first (Baarda): w_i = (S^-1 nu)_i / sqrt((S^-1)_ii) against chi2(1, p).
-    const double threshold = gnss::chi_square_quantile(o_.fault_probability, 1);
+    const double threshold = w_test_threshold_;
     std::vector<int>& active = active_;
     active.resize(rows.size());
     for (size_t i = 0; i < rows.size(); ++i) active[i] = static_cast<int>(i);
@@ -1061,6 +1067,7 @@ class Runner {
   const EngineInputs& in_;
   const EngineOptions& o_;
   const std::vector<ins::ZuptDecision>& decisions_;
+  const double w_test_threshold_;  // chi2(1) quantile at o_.fault_probability
   std::vector<gnss::BaseMatch> matches_;
   bool sd_ = false;
   FrameYaw frame_;

@@ -82,7 +82,7 @@ bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR
   // Joseph form, expanded (exact for any gain K, so a rounding error in K still enters P only to second order):
   // (I − K H) P (I − K H)ᵀ + K R Kᵀ = P − K Uᵀ − U Kᵀ + K S Kᵀ with U = P Hᵀ and S = H U + R
   //                                 = P − K Wᵀ − W Kᵀ with W = U − ½ K S
-  // (docs/fusion.md eq. 4.6): a symmetric rank-2m update, computed on the upper triangle and mirrored — n(n+1)·m
+  // (docs/fusion.md eq. 6.4): a symmetric rank-2m update, computed on the upper triangle and mirrored — n(n+1)·m
   // multiply-adds instead of the two n×m×n products of T = P − K H P, T − (T Hᵀ − K R) Kᵀ.
   ColsMatrix W = PHt;
   W.noalias() -= 0.5 * (K * S);

@@ -4,7 +4,9 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 
 namespace pednav::gnss {
 namespace {
@@ -125,6 +127,20 @@ const char* epoch_failure_name(EpochFailure f) {
 }
 
 double chi_square_quantile(double p, int dof) {
+  // The callers ask for the same few (p, dof) at every epoch (the RAIM and w-test thresholds): the last answers
+  // are kept per thread (Monte Carlo runs filters in parallel), keyed by p, for dof < 64.
+  constexpr int kCachedDof = 64;
+  thread_local double cached_p = std::numeric_limits<double>::quiet_NaN();
+  thread_local std::array<double, kCachedDof> cached{};
+  const bool cacheable = dof >= 0 && dof < kCachedDof;
+  if (cacheable) {
+    if (p != cached_p) {
+      cached_p = p;
+      cached.fill(-1.0);
+    } else if (cached[static_cast<size_t>(dof)] >= 0.0) {
+      return cached[static_cast<size_t>(dof)];
+    }
+  }
   // Bisection on the CDF P(dof/2, x/2).
   double lo = 0.0, hi = std::max(10.0, 10.0 * dof);
   while (gamma_p(0.5 * dof, 0.5 * hi) < p) hi *= 2.0;
@@ -132,7 +148,9 @@ double chi_square_quantile(double p, int dof) {
     const double mid = 0.5 * (lo + hi);
     (gamma_p(0.5 * dof, 0.5 * mid) < p ? lo : hi) = mid;
   }
-  return 0.5 * (lo + hi);
+  const double q = 0.5 * (lo + hi);
+  if (cacheable) cached[static_cast<size_t>(dof)] = q;
+  return q;
 }
 
 EpochSolution solve_epoch(const NavData& nav, const ObsEpoch& rover, const ObsEpoch* base,

@@ -98,6 +98,12 @@ TEST(Measurement, ChiSquareQuantiles) {
   EXPECT_NEAR(chi_square_quantile(0.999, 1), 10.828, 1e-3);
   EXPECT_NEAR(chi_square_quantile(0.95, 5), 11.070, 1e-3);
   EXPECT_NEAR(chi_square_quantile(0.99, 20), 37.566, 1e-3);
+  // Answers are cached per (p, dof): asking again, or for another p in between, gives the same values.
+  EXPECT_NEAR(chi_square_quantile(0.95, 5), 11.070, 1e-3);
+  EXPECT_NEAR(chi_square_quantile(0.999, 1), 10.828, 1e-3);
+  EXPECT_NEAR(chi_square_quantile(0.999, 1), 10.828, 1e-3);
+  EXPECT_NEAR(chi_square_quantile(0.95, 1), 3.841, 1e-3);
+  EXPECT_NEAR(chi_square_quantile(0.999, 100), 149.449, 1e-3);  // beyond the cached dof range
 }
 
 TEST(Measurement, ElevationAzimuthOfZenithAndNorth) {
