@@ -34,6 +34,31 @@ void drop_short_runs(std::vector<ZuptDecision>& d, const std::vector<ImuSample>&
 
 }  // namespace
 
+// Seed 004's Δt applied to the HMM's stance: the foot cannot push off and stand again without a swing. Such a run is
+// a D decoded on the in-air zero crossing of the rate between push-off and swing (LORD #34 at 7.01 s and 7.91 s, #38
+// at 17.52 s: each 0.05 s long, 0.22-0.26 s after the true stance ended; docs/zupt.md §3).
+void drop_stances_right_after_push_off(std::vector<ZuptDecision>& d, const std::vector<ImuSample>& s, double min_s) {
+  if (min_s <= 0.0) return;
+  std::ptrdiff_t last_end = -1;  // sample index of the last kept stance run's end
+  bool pushed_off = false;       // a push-off sample since last_end
+  for (std::size_t i = 0; i < d.size();) {
+    if (!d[i].stance) {
+      pushed_off = pushed_off || d[i].gait_state == kPushOff;
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j + 1 < d.size() && d[j + 1].stance) ++j;
+    if (last_end >= 0 && pushed_off && s[i].t - s[static_cast<std::size_t>(last_end)].t < min_s) {
+      for (std::size_t k = i; k <= j; ++k) d[k].stance = false;
+    } else {
+      last_end = static_cast<std::ptrdiff_t>(j);
+      pushed_off = false;
+    }
+    i = j + 1;
+  }
+}
+
 std::vector<std::string> ZuptDetectorOptions::problems() const {
   std::vector<std::string> p;
   if (detector != "mv" && detector != "shoe" && detector != "are" && detector != "mag" && detector != "hmm") {
@@ -51,6 +76,7 @@ std::vector<std::string> ZuptDetectorOptions::problems() const {
     }
     if (hmm_max_iterations < 0) p.push_back("zupt.hmm_max_iterations must be >= 0");
     if (!(hmm_decode_floor >= 0 && hmm_decode_floor < 0.01)) p.push_back("zupt.hmm_decode_floor must be in [0, 0.01)");
+    if (!(hmm_min_swing_s >= 0)) p.push_back("zupt.hmm_min_swing_s must be >= 0");
   }
   if (mv_window_s <= 0) p.push_back("zupt.mv_window_s must be > 0");
   if (mv_threshold_mps2 <= 0) p.push_back("zupt.mv_threshold_mps2 must be > 0");
@@ -172,6 +198,7 @@ HmmDetection detect_gait_hmm(const std::vector<ImuSample>& s, const ZuptDetector
     }
   }
   drop_short_runs(h.decisions, s, o.min_stance_s);
+  drop_stances_right_after_push_off(h.decisions, s, o.hmm_min_swing_s);
   return h;
 }
 

@@ -51,6 +51,10 @@ struct ZuptDetectorOptions {
   /// stance whatever state was decoded (docs/zupt.md §3: a long rest is one merged observation that the trained
   /// cycle, which has no D -> D transition, may decode as push-off). <= 0: off.
   double hmm_rest_s = 0.5;
+  /// HMM: a stance run that begins less than this after the previous stance run ended, with a push-off decoded in
+  /// between, is not stance (seed 004's Δt for the HMM; docs/zupt.md §3): after a push-off the foot must swing and
+  /// land first. <= 0: off.
+  double hmm_min_swing_s = 0.3;
   /// HMM: stance shortening by the SHOE statistic T (same window, sigmas and γ as `shoe`), a threshold that adapts
   /// to gait speed: in each decoded stance interval only the contiguous run around the minimum T_min of T with
   /// T < max(γ, factor · T_min) is kept, widened to min_stance_s (docs/zupt.md §3). <= 0: off.
@@ -66,6 +70,11 @@ struct ZuptDecision {
   double statistic = 0.0;  ///< mv: std(|f|) [m/s^2]; shoe, are, mag: T; hmm: smoothed signed axis rate [rad/s]
   int gait_state = -1;     ///< hmm: decoded state per sample (GaitState 0..3), else -1
 };
+
+/// HMM post-processing (docs/zupt.md §3): a stance run of `d` that begins less than min_s after the previous kept
+/// stance run ended, with a push-off (gait_state kPushOff) in between, is set to swing. Gaps without a push-off (a
+/// stance interrupted by a flicker) are left alone.
+void drop_stances_right_after_push_off(std::vector<ZuptDecision>& d, const std::vector<ImuSample>& s, double min_s);
 
 /// The HMM detector's by-products (for `pednav zupt` and the documentation).
 struct HmmDetection {

@@ -83,6 +83,7 @@ struct ZuptConfig {
   int hmm_max_iterations = 200;
   std::string hmm_decoder = "viterbi";    ///< viterbi | forward
   double hmm_rest_s = 0.5;                ///< rest of at least this long is stance (ins::ZuptDetectorOptions)
+  double hmm_min_swing_s = 0.3;           ///< no stance this soon after a stance and a push-off (ins::ZuptDetectorOptions)
   double hmm_refine_factor = 0.0;         ///< stance shortening by SHOE, adaptive threshold (0: off)
   double shoe_adaptive_factor = 0.0;      ///< gait-adaptive SHOE threshold factor (0: off; ins::ZuptDetectorOptions)
   double shoe_adaptive_window_s = 0.6;

@@ -168,6 +168,7 @@ void read_zupt_hmm_keys(YamlMap& z, ZuptConfig& c) {
   z.integer("hmm_max_iterations", c.hmm_max_iterations, false, 0, 100000);
   z.choice("hmm_decoder", c.hmm_decoder, {"viterbi", "forward"});
   z.number("hmm_rest_s", c.hmm_rest_s, false, 0.0, 60.0);
+  z.number("hmm_min_swing_s", c.hmm_min_swing_s, false, 0.0, 5.0);
   z.number("hmm_refine_factor", c.hmm_refine_factor, false, 0.0, 1e6);
   z.number("shoe_adaptive_factor", c.shoe_adaptive_factor, false, 0.0, 1e6);
   z.number("shoe_adaptive_window_s", c.shoe_adaptive_window_s, false, 0.0, 10.0);
@@ -221,6 +222,7 @@ ins::ZuptDetectorOptions zupt_detector_options(const ZuptConfig& c) {
   o.hmm_max_iterations = c.hmm_max_iterations;
   o.hmm_decoder = c.hmm_decoder;
   o.hmm_rest_s = c.hmm_rest_s;
+  o.hmm_min_swing_s = c.hmm_min_swing_s;
   o.hmm_refine_factor = c.hmm_refine_factor;
   o.shoe_adaptive_factor = c.shoe_adaptive_factor;
   o.shoe_adaptive_window_s = c.shoe_adaptive_window_s;

@@ -1,8 +1,10 @@
-// HMM zero-velocity detector (seed 002; docs/zupt.md §3) on the x-io long loop with the committed configuration
-// datasets/foot/xio_long.yaml, detector switched to hmm: two mapping rules measured on this log.
+// HMM zero-velocity detector (seed 002; docs/zupt.md §3) on real logs with the committed configurations, detector
+// switched to hmm: the mapping rules measured on the x-io long loop, and the push-off rule on LORD hallway #34.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "io/config.hpp"
 #include "io/hmm_model_io.hpp"
@@ -41,6 +43,46 @@ TEST(DataZuptHmm, XioLongRestIsStanceAndStanceIsNearZeroRate) {
   }
   EXPECT_EQ(final_rest_moving, 0);
   EXPECT_EQ(stance_off_zero, 0);
+}
+
+// Stance intervals of a detection: [first, last] sample times since the log start [s].
+std::vector<std::pair<double, double>> stance_intervals(const std::vector<ZuptDecision>& d,
+                                                        const std::vector<ImuSample>& s) {
+  std::vector<std::pair<double, double>> out;
+  for (std::size_t i = 0; i < d.size();) {
+    if (!d[i].stance) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j + 1 < d.size() && d[j + 1].stance) ++j;
+    out.emplace_back(s[i].t - s.front().t, s[j].t - s.front().t);
+    i = j + 1;
+  }
+  return out;
+}
+
+// LORD hallway #34 (25 footprints incl. the start and end rest, fast walk): the trained model decodes two 0.05 s
+// stances on the in-air zero crossing right after a push-off (7.01 s and 7.91 s, 0.22 / 0.26 s after the true
+// stance). hmm_min_swing_s drops them: 25 stance intervals, one per footprint; without it 27.
+TEST(DataZuptHmm, LordStanceRightAfterPushOffIsDropped) {
+  PEDNAV_REQUIRE_DATA(test::shared_data("foot_lord_gcp_hallway/SensorConnectData_34.csv"));
+  auto cfg = io::load_run_config(test::source_path("datasets/foot/lord_34.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  auto log = io::read_imu_csv(cfg->imu.file, cfg->imu.format);
+  ASSERT_TRUE(log) << log.error().message;
+  const auto& s = log->samples;
+  ZuptDetectorOptions o = io::zupt_detector_options(cfg->zupt);
+  o.detector = "hmm";
+  ASSERT_GT(o.hmm_min_swing_s, 0.26);
+  const auto with = stance_intervals(detect_gait_hmm(s, o).decisions, s);
+  EXPECT_EQ(with.size(), 25u);
+  for (const auto& [a, b] : with) {
+    EXPECT_FALSE(a > 6.9 && a < 7.1) << a << "-" << b;
+    EXPECT_FALSE(a > 7.8 && a < 8.0) << a << "-" << b;
+  }
+  o.hmm_min_swing_s = 0.0;
+  EXPECT_EQ(stance_intervals(detect_gait_hmm(s, o).decisions, s).size(), 27u);
 }
 
 }  // namespace

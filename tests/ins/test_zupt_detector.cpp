@@ -239,5 +239,35 @@ TEST(ZuptDetector, HmmRefineThresholdAdaptsToAFootThatNeverStops) {
   EXPECT_LE(a.rolling, 8 * g.stances);
 }
 
+// hmm_min_swing_s: a stance run right after a push-off is dropped, a stance broken by a flicker is not, and a
+// stance after a full swing is kept (100 Hz decisions built by hand: D = stance, A = push-off, B = swing).
+TEST(ZuptDetector, StanceRightAfterPushOffIsDropped) {
+  const char* gait = "DDDDDDDDDDAAAAAAAAAADDDDDDDDAAAAABBBBBBBBBBBBBBBBBBBBBBBBBBBBBBBCCDDDDD.DDDDDD";
+  // D 0-9, A 10-19, D 20-27, A 28-32, B 33-63, C 64-65, D 66-70, flicker 71, D 72-77
+  std::vector<ImuSample> s;
+  std::vector<ZuptDecision> d;
+  for (int k = 0; gait[k] != '\0'; ++k) {
+    ImuSample x;
+    x.t = GpsTime::from_week_tow(0, 0.01 * k);
+    s.push_back(x);
+    ZuptDecision z;
+    const char c = gait[k];
+    z.stance = c == 'D';
+    z.gait_state = c == 'A' ? kPushOff : c == 'B' ? kSwing : c == 'C' ? kHeelStrike : kStance;
+    d.push_back(z);
+  }
+  auto stance_at = [&](int k) { return d[static_cast<std::size_t>(k)].stance; };
+  drop_stances_right_after_push_off(d, s, 0.3);
+  EXPECT_TRUE(stance_at(5));    // the first stance is kept
+  EXPECT_FALSE(stance_at(24));  // 0.11 s after the first stance, a push-off in between: dropped
+  EXPECT_TRUE(stance_at(68));   // after push-off, swing and heel strike (0.58 s): kept
+  EXPECT_TRUE(stance_at(75));   // the same stance after a one-sample flicker (no push-off): kept
+  // Off: nothing changes.
+  std::vector<ZuptDecision> d0 = d;
+  d0[24].stance = true;
+  drop_stances_right_after_push_off(d0, s, 0.0);
+  EXPECT_TRUE(d0[24].stance);
+}
+
 }  // namespace
 }  // namespace pednav::ins
