@@ -48,6 +48,8 @@ struct McOptions {
   bool multipath_states = false;   ///< filter multipath GM states with the scenario's multipath model
   bool white_code = false;         ///< no multipath states (white code errors in R, the default before session 4)
   bool scale_states = false;       ///< filter scale-factor states (the scenario's IMU spec)
+  bool accel_scale_states = false; ///< filter accelerometer scale-factor states only
+  bool bias_random_walk = false;   ///< filter bias model: turn-on constant + random walk (`bias: {model: random_walk}`)
 };
 
 // One finished run (what runs.csv shows), with its per-epoch errors.
@@ -113,7 +115,9 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
   c.zupt.form = mo.zupt_form;
   c.smoother_enabled = mo.smoother;
   fusion::EngineOptions o = io::engine_options(c);
-  if (mo.scale_states) o.estimate_scale_factors = true;
+  if (mo.scale_states || mo.accel_scale_states) o.estimate_scale_factors = true;
+  if (mo.accel_scale_states) o.estimate_gyro_scale_factors = false;
+  if (mo.bias_random_walk) o.bias_random_walk = true;
   if (mo.multipath_states) {
     // The filter's multipath model = the simulator's (docs/consistency.md §3).
     o.multipath_sigma_m = sc.gnss.multipath_sigma_m;
@@ -410,6 +414,11 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
                 "No multipath states (white code errors; `multipath: {states: false}` of pednav run)")
       ->excludes("--multipath-states");
   cmd->add_flag("--scale-states", mo->scale_states, "Filter gyro/accelerometer scale-factor states");
+  cmd->add_flag("--accel-scale-states", mo->accel_scale_states,
+                "Filter accelerometer scale-factor states only (`scale_factors: {states: true, gyro: false}`)")
+      ->excludes("--scale-states");
+  cmd->add_flag("--bias-random-walk", mo->bias_random_walk,
+                "Filter bias model: turn-on bias constant + random walk (`bias: {model: random_walk}`)");
   cmd->add_flag("--step-velocity", mo->step_velocity, "Seed 000 step-averaged velocity aiding");
   cmd->add_option("--leg-length-m", mo->leg_length_m, "Inverted-pendulum length l of the step-length model [m]")
       ->check(CLI::Range(0.05, 3.0));

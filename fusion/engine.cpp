@@ -82,13 +82,34 @@ struct Row {
   double sigma = 0.0;
 };
 
+// The IMU spec as the filter models it. With bias_random_walk the Gauss-Markov bias part (σ, τ) becomes a random
+// walk of the same PSD 2σ²/τ (docs/error_state.md eq. 3.4-3.5 with τ <= 0): the state's turn-on variance then stays
+// until a measurement reduces it, instead of decaying with τ (which the one-state GM model does although the
+// turn-on bias is a constant: at τ = 300 s the Crista's 30 mg prior is "forgotten" to 20 mg within a 120 s static
+// start, unobserved; docs/consistency.md §3.2). initial_covariance still takes max(turn-on, instability).
+ins::ImuSpec filter_spec(const EngineOptions& o) {
+  ins::ImuSpec s = o.spec;
+  if (!o.bias_random_walk) return s;
+  auto to_walk = [](double& instability, double& tau_s, double& rw, double& initial) {
+    if (!(instability > 0.0 && tau_s > 0.0)) return;
+    initial = std::max(initial, instability);
+    rw = std::sqrt(rw * rw + 2.0 * instability * instability / tau_s);
+    instability = 0.0;
+    tau_s = 0.0;
+  };
+  to_walk(s.gyro_bias_instability, s.gyro_bias_tau_s, s.gyro_bias_rw, s.gyro_bias_initial);
+  to_walk(s.accel_bias_instability, s.accel_bias_tau_s, s.accel_bias_rw, s.accel_bias_initial);
+  return s;
+}
+
 // The filter state: nominal INS state + differential clocks, error covariance. Matrices have a fixed capacity
 // (ins::ErrorMatrix): nothing here allocates on the heap per step (docs/performance.md).
 class Filter {
  public:
-  Filter(const EngineOptions& o, int n_clocks) : o_(o) {
+  Filter(const EngineOptions& o, int n_clocks) : o_(o), spec_(filter_spec(o)) {
     if (o.estimate_scale_factors) {  // the INS error model owns these blocks (docs/error_state.md)
       for (const char* name : {ins::kScaleGyroBlock, ins::kScaleAccBlock}) {
+        if (!o.estimate_gyro_scale_factors && std::string(name) == ins::kScaleGyroBlock) continue;
         if (auto b = layout_.add(name, 3); !b) {
           problem_ = b.error().message;
           return;
@@ -132,7 +153,7 @@ class Filter {
     x_.nav = nav;
     x_.imu = imu;
     const double st = o_.initial_sigma_tilt_rad;
-    P_ = ins::initial_covariance(layout_, o_.spec, o_.initial_sigma_pos_m, o_.initial_sigma_vel_mps,
+    P_ = ins::initial_covariance(layout_, spec_, o_.initial_sigma_pos_m, o_.initial_sigma_vel_mps,
                                  Vector3d(st, st, st));
     // The attitude block is resolved in e: build it from NED sigmas (tilt, tilt, yaw).
     const Geodetic llh = geodetic_from_ecef(nav.p_eb_e);
@@ -161,7 +182,7 @@ class Filter {
   void predict(const ins::ImuIncrement& inc) {
     const ins::NavState after = ins::mechanize(x_.nav, inc);
     ins::DiscreteErrorModel& m = model_;
-    ins::interval_error_model(layout_, o_.spec, x_.nav, after, inc, m);
+    ins::interval_error_model(layout_, spec_, x_.nav, after, inc, m);
     const double dt = inc.dt_s;
     if (o_.mode == Mode::kTightlyCoupled) {
       const int d = drift_block_.offset;
@@ -344,6 +365,7 @@ class Filter {
 
  private:
   const EngineOptions& o_;
+  const ins::ImuSpec spec_;  // the IMU error model the filter uses (filter_spec)
   ins::ErrorStateLayout layout_;
   std::string problem_;
   std::vector<ins::Block> clock_blocks_;

@@ -65,6 +65,15 @@ struct EngineOptions {
   /// Estimate gyro and accelerometer scale-factor errors (ins layout blocks scale_gyro, scale_acc with the spec's
   /// *_scale_sigma and scale_tau_s). Off: scale-factor errors are not modelled (docs/consistency.md §3).
   bool estimate_scale_factors = false;
+  /// With estimate_scale_factors: also the gyro block (false: the accelerometer block scale_acc only). The gyro
+  /// scale states are the ones that diverge on a clipped gyro (docs/consistency.md §3); the accelerometer scale
+  /// errors are the ones that make the vertical dishonest (docs/consistency.md §3.2).
+  bool estimate_gyro_scale_factors = true;
+  /// IMU bias model of the filter. false: one first-order Gauss-Markov state per axis with the spec's instability σ
+  /// and τ, started at the turn-on σ — its variance then decays towards the instability σ within ~τ whether or not
+  /// anything observes the bias. true: the turn-on bias is a random constant and the instability a random walk of
+  /// the same short-term PSD 2σ²/τ (no decay; conservative beyond τ). docs/error_state.md §3, docs/consistency.md §3.2.
+  bool bias_random_walk = false;
   /// Code multipath as one unit-variance first-order Gauss-Markov state u_s per tracked satellite (docs/consistency.md
   /// §3): the code error gets σ_mp · u_s, σ_mp = multipath_sigma_m · 10^(max(0, cn0_ref − C/N0)/20) per receiver
   /// (rover and base in quadrature for SD). multipath_sigma_m = 0: no multipath states (code errors white).

@@ -123,7 +123,9 @@ std::string to_yaml(const RunConfig& c) {
     << YAML::Key << "slots" << YAML::Value << c.multipath.slots << YAML::Key << "reset_gap_s" << YAML::Value
     << c.multipath.reset_gap_s << YAML::EndMap;
   e << YAML::Key << "scale_factors" << YAML::Value << YAML::BeginMap << YAML::Key << "states" << YAML::Value
-    << c.scale_factors.states << YAML::EndMap;
+    << c.scale_factors.states << YAML::Key << "gyro" << YAML::Value << c.scale_factors.gyro << YAML::EndMap;
+  e << YAML::Key << "bias" << YAML::Value << YAML::BeginMap << YAML::Key << "model" << YAML::Value << c.bias.model
+    << YAML::EndMap;
   e << YAML::Key << "output" << YAML::Value << YAML::BeginMap << YAML::Key << "rate_hz" << YAML::Value
     << c.output.rate_hz << YAML::Key << "formats" << YAML::Value << YAML::Flow << c.output.formats << YAML::EndMap;
   e << YAML::EndMap;

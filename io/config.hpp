@@ -132,6 +132,14 @@ struct MultipathConfig {
 /// `scale_factors:` section: IMU scale-factor states (the spec's *_scale_sigma, docs/consistency.md §3).
 struct ScaleFactorConfig {
   bool states = false;  ///< off: in ins mode they degrade INS/ZUPT (docs/consistency.md §3)
+  bool gyro = true;     ///< with states: also the gyro block (false: accelerometer scale factors only, §3.2)
+};
+
+/// `bias:` section: how the filter models the IMU biases (docs/consistency.md §3.2).
+struct BiasConfig {
+  /// gauss_markov: one GM state per axis (instability σ, τ) started at the turn-on σ; random_walk: the turn-on
+  /// bias a random constant, the instability a random walk of PSD 2σ²/τ.
+  std::string model = "gauss_markov";
 };
 
 /// `output:` section.
@@ -157,6 +165,7 @@ struct RunConfig {
   OutputConfig output;
   MultipathConfig multipath;
   ScaleFactorConfig scale_factors;
+  BiasConfig bias;
 };
 
 /// Read and validate a run configuration; every problem is reported at once ("file:line: yaml.path: what").

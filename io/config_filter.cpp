@@ -99,6 +99,11 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
   {
     YamlMap s = top.map("scale_factors");
     s.boolean("states", out.scale_factors.states);
+    s.boolean("gyro", out.scale_factors.gyro);
+  }
+  {
+    YamlMap b = top.map("bias");
+    b.choice("model", out.bias.model, {"gauss_markov", "random_walk"});
   }
 }
 

@@ -136,6 +136,8 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.multipath_slots = c.multipath.slots;
   o.multipath_reset_gap_s = c.multipath.reset_gap_s;
   o.estimate_scale_factors = c.scale_factors.states;
+  o.estimate_gyro_scale_factors = c.scale_factors.gyro;
+  o.bias_random_walk = c.bias.model == "random_walk";
   return o;
 }
 

@@ -98,6 +98,26 @@ TEST(Config, ResolvedYamlParsesBackToTheSameConfig) {
 namespace pednav::io {
 namespace {
 
+TEST(Config, AccelOnlyScaleStatesAndBiasModelKeys) {
+  auto cfg = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\nscale_factors:\n  states: true\n  gyro: false\n"
+                   "bias:\n  model: random_walk\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_TRUE(cfg->scale_factors.states);
+  EXPECT_FALSE(cfg->scale_factors.gyro);
+  EXPECT_EQ(cfg->bias.model, "random_walk");
+  auto again = parse(to_yaml(*cfg));  // config.resolved.yaml reads back to the same values
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_FALSE(again->scale_factors.gyro);
+  EXPECT_EQ(again->bias.model, "random_walk");
+  auto defaults = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\n");
+  ASSERT_TRUE(defaults) << defaults.error().message;
+  EXPECT_TRUE(defaults->scale_factors.gyro);
+  EXPECT_EQ(defaults->bias.model, "gauss_markov");
+  auto bad = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\nbias:\n  model: rw\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("bias.model: expected one of {gauss_markov, random_walk}, got 'rw'"));
+}
+
 TEST(Config, MultipathAndScaleFactorStateKeys) {
   auto cfg = parse(
       "mode: gnss\nrover_obs: r.obs\nnav: n.nav\nmultipath:\n  states: true\n  sigma_m: 0.5\n  tau_s: 30\n"
