@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -20,15 +21,27 @@ namespace {
 // last 14 s have no ZUPT (INS end-point error 186 m). Every sample of the last kFinalRest_s must be stance.
 constexpr double kFinalRest_s = 10.0;
 
-TEST(DataZuptHmm, XioLongRestIsStanceAndStanceIsNearZeroRate) {
-  PEDNAV_REQUIRE_DATA(test::shared_data("foot_xio_ngimu_loops/long_walk.csv"));
-  auto cfg = io::load_run_config(test::source_path("datasets/foot/xio_long.yaml"));
+// The IMU log and the detector options (switched to hmm) of a committed configuration datasets/foot/<name>.yaml.
+struct HmmCase {
+  std::vector<ImuSample> samples;
+  ZuptDetectorOptions options;
+};
+void load_hmm_case(const std::string& name, HmmCase& out) {
+  auto cfg = io::load_run_config(test::source_path("datasets/foot/" + name + ".yaml"));
   ASSERT_TRUE(cfg) << cfg.error().message;
   auto log = io::read_imu_csv(cfg->imu.file, cfg->imu.format);
   ASSERT_TRUE(log) << log.error().message;
-  const auto& s = log->samples;
-  ZuptDetectorOptions o = io::zupt_detector_options(cfg->zupt);
-  o.detector = "hmm";
+  out.samples = std::move(log->samples);
+  out.options = io::zupt_detector_options(cfg->zupt);
+  out.options.detector = "hmm";
+}
+
+TEST(DataZuptHmm, XioLongRestIsStanceAndStanceIsNearZeroRate) {
+  PEDNAV_REQUIRE_DATA(test::shared_data("foot_xio_ngimu_loops/long_walk.csv"));
+  HmmCase c;
+  ASSERT_NO_FATAL_FAILURE(load_hmm_case("xio_long", c));
+  const auto& s = c.samples;
+  ZuptDetectorOptions o = c.options;
   o.hmm_refine_factor = 0.0;  // the decoded stance itself
   const HmmDetection h = detect_gait_hmm(s, o);
   ASSERT_EQ(h.decisions.size(), s.size());
@@ -67,22 +80,17 @@ std::vector<std::pair<double, double>> stance_intervals(const std::vector<ZuptDe
 // stance). hmm_min_swing_s drops them: 25 stance intervals, one per footprint; without it 27.
 TEST(DataZuptHmm, LordStanceRightAfterPushOffIsDropped) {
   PEDNAV_REQUIRE_DATA(test::shared_data("foot_lord_gcp_hallway/SensorConnectData_34.csv"));
-  auto cfg = io::load_run_config(test::source_path("datasets/foot/lord_34.yaml"));
-  ASSERT_TRUE(cfg) << cfg.error().message;
-  auto log = io::read_imu_csv(cfg->imu.file, cfg->imu.format);
-  ASSERT_TRUE(log) << log.error().message;
-  const auto& s = log->samples;
-  ZuptDetectorOptions o = io::zupt_detector_options(cfg->zupt);
-  o.detector = "hmm";
-  ASSERT_GT(o.hmm_min_swing_s, 0.26);
-  const auto with = stance_intervals(detect_gait_hmm(s, o).decisions, s);
+  HmmCase c;
+  ASSERT_NO_FATAL_FAILURE(load_hmm_case("lord_34", c));
+  ASSERT_GT(c.options.hmm_min_swing_s, 0.26);
+  const auto with = stance_intervals(detect_gait_hmm(c.samples, c.options).decisions, c.samples);
   EXPECT_EQ(with.size(), 25u);
   for (const auto& [a, b] : with) {
     EXPECT_FALSE(a > 6.9 && a < 7.1) << a << "-" << b;
     EXPECT_FALSE(a > 7.8 && a < 8.0) << a << "-" << b;
   }
-  o.hmm_min_swing_s = 0.0;
-  EXPECT_EQ(stance_intervals(detect_gait_hmm(s, o).decisions, s).size(), 27u);
+  c.options.hmm_min_swing_s = 0.0;
+  EXPECT_EQ(stance_intervals(detect_gait_hmm(c.samples, c.options).decisions, c.samples).size(), 27u);
 }
 
 }  // namespace
