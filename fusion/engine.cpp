@@ -224,9 +224,9 @@ class Filter {
     // current error are conditioned on the same measurement, with the filter's S and K (docs/fusion.md eqs.
     // 12.16-12.17).
     const bool ok = recording_
-                        ? joseph_update(P_, H, r, R, dx, tmp_,
+                        ? joseph_update(P_, H, r, R, dx,
                                         [&](const auto& S_ldlt, const auto& K) { interval_.update(H, r, S_ldlt, K); })
-                        : joseph_update(P_, H, r, R, dx, tmp_);
+                        : joseph_update(P_, H, r, R, dx);
     if (!ok) return false;
     apply(dx);
     return true;

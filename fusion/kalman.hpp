@@ -53,7 +53,7 @@ inline void covariance_predict(ins::ErrorMatrix& P, const ColumnSparse<ins::kMax
 /// bookkeeping, fusion::RtsInterval::update).
 template <typename MatH, typename VecR, typename MatR, typename OnGain>
 bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR& R, ins::ErrorVector& dx,
-                   ins::ErrorMatrix& tmp, OnGain&& on_gain) {
+                   OnGain&& on_gain) {
   using ColsMatrix = Eigen::Matrix<double, Eigen::Dynamic, MatH::RowsAtCompileTime, Eigen::ColMajor,
                                    ins::kMaxErrorDim, MatH::MaxRowsAtCompileTime>;
   using SMatrix = Eigen::Matrix<double, MatH::RowsAtCompileTime, MatH::RowsAtCompileTime, Eigen::ColMajor,
@@ -94,15 +94,13 @@ bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR
     }
   }
   mirror_upper(P);
-  (void)tmp;
   return true;
 }
 
 /// The same without a callback.
 template <typename MatH, typename VecR, typename MatR>
-bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR& R, ins::ErrorVector& dx,
-                   ins::ErrorMatrix& tmp) {
-  return joseph_update(P, H, r, R, dx, tmp, [](const auto&, const auto&) {});
+bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR& R, ins::ErrorVector& dx) {
+  return joseph_update(P, H, r, R, dx, [](const auto&, const auto&) {});
 }
 
 }  // namespace pednav::fusion

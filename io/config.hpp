@@ -186,6 +186,10 @@ void read_zupt_hmm_keys(YamlMap& zupt, ZuptConfig& out);
 void read_imu_format(YamlMap& m, ImuFormat& out);
 /// Read inline IMU spec keys (unit-suffixed, README "IMU spec") from `m` into `out` (SI).
 void read_imu_spec(YamlMap& m, ins::ImuSpec& out);
+/// m[key] as an IMU spec: a preset name, or a map {preset: NAME, <read_imu_spec keys>} overriding the preset's values.
+/// `preset` holds the default preset on entry ("" = none: a map then starts from ins::ImuSpec{}) and the name used on
+/// return; problems (unknown preset or key) go to m's problem list.
+void read_imu_spec_entry(YamlMap& m, const std::string& key, ins::ImuSpec& spec, std::string& preset);
 /// A built-in IMU format preset (datasets/imu_formats/<name>.yaml), parsed.
 Expected<ImuFormat> imu_format_preset(const std::string& name);
 

@@ -171,31 +171,28 @@ void read_imu_section(YamlMap& top, ImuConfig& out) {
   }
   if (imu.has("spec")) {
     out.has_spec = true;
-    const YAML::Node n = imu.raw("spec");
-    if (n.IsScalar()) {
-      imu.text("spec", out.spec_preset);
-      auto s = ins::imu_spec_preset(out.spec_preset);
-      if (s) {
-        out.spec = *s;
-      } else {
-        imu.problem("spec", s.error().message);
-      }
+    read_imu_spec_entry(imu, "spec", out.spec, out.spec_preset);
+  }
+}
+
+void read_imu_spec_entry(YamlMap& m, const std::string& key, ins::ImuSpec& spec, std::string& preset) {
+  auto start_from_preset = [&](YamlMap& where, const std::string& preset_key) {
+    if (preset.empty()) return;
+    if (auto s = ins::imu_spec_preset(preset)) {
+      spec = *s;
     } else {
-      YamlMap m = imu.map("spec");
-      std::string base;
-      m.text("preset", base);
-      if (!base.empty()) {
-        auto s = ins::imu_spec_preset(base);
-        if (s) {
-          out.spec = *s;
-          out.spec_preset = base;
-        } else {
-          m.problem("preset", s.error().message);
-        }
-      }
-      out.spec.name = base.empty() ? "inline" : base + "+inline";
-      read_imu_spec(m, out.spec);
+      where.problem(preset_key, s.error().message);
     }
+  };
+  if (m.has(key) && !m.raw(key).IsScalar()) {
+    YamlMap sm = m.map(key);
+    sm.text("preset", preset);
+    start_from_preset(sm, "preset");
+    spec.name = preset.empty() ? "inline" : preset + "+inline";
+    read_imu_spec(sm, spec);
+  } else {
+    m.text(key, preset);
+    start_from_preset(m, key);
   }
 }
 

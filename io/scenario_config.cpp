@@ -222,26 +222,10 @@ Expected<ScenarioFile> parse_scenario(const std::string& yaml_text, const std::s
       YamlMap m = top.map("imu");
       sim::ImuOptions& o = sc.imu;
       m.number("rate_hz", o.rate_hz, false, 20.0, 2000.0);
-      // spec: a preset name, or a map {preset: NAME, <ImuSpec keys>...} overriding the preset's values (the same
-      // vocabulary as a run configuration's imu.spec, docs/config.md), e.g. a wider gyro range.
+      // spec: a preset name, or a map {preset: NAME, <ImuSpec keys>...} overriding the preset's values (the vocabulary
+      // of a run configuration's imu.spec), e.g. a wider gyro range.
       out.imu_spec_preset = "crista";
-      if (m.has("spec") && !m.raw("spec").IsScalar()) {
-        YamlMap sm = m.map("spec");
-        sm.text("preset", out.imu_spec_preset);
-        if (auto s = ins::imu_spec_preset(out.imu_spec_preset)) {
-          o.spec = *s;
-        } else {
-          sm.problem("preset", s.error().message);
-        }
-        read_imu_spec(sm, o.spec);
-      } else {
-        m.text("spec", out.imu_spec_preset);
-        if (auto s = ins::imu_spec_preset(out.imu_spec_preset)) {
-          o.spec = *s;
-        } else {
-          m.problem("spec", s.error().message);
-        }
-      }
+      read_imu_spec_entry(m, "spec", o.spec, out.imu_spec_preset);
       m.boolean("errors", o.errors);
       double mis_mrad = o.misalignment_sigma_rad * 1e3;
       m.number("misalignment_mrad", mis_mrad, false, 0.0, 100.0);

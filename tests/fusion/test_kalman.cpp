@@ -78,9 +78,9 @@ TEST_P(KalmanSizes, JosephUpdateEqualsTheTextbookFormAndIsSymmetric) {
   for (int i = 0; i < 6; ++i) r(i) = nd(rng);
   R6 R = R6::Zero(6, 6);
   R.diagonal() << 4e-4, 4e-4, 4e-4, 1e-4, 1e-4, 1e-4;
-  ErrorMatrix P = P0, tmp;
+  ErrorMatrix P = P0;
   ErrorVector dx;
-  ASSERT_TRUE(fusion::joseph_update(P, H, r, R, dx, tmp));
+  ASSERT_TRUE(fusion::joseph_update(P, H, r, R, dx));
 
   const Eigen::MatrixXd Pd = P0, Hd = H, Rd = R;
   const Eigen::MatrixXd K = Pd * Hd.transpose() * (Hd * Pd * Hd.transpose() + Rd).inverse();
@@ -102,9 +102,9 @@ TEST(Kalman, JosephUpdateRefusesANonPositiveInnovationCovariance) {
   H(0, 3) = 1.0;
   V6 r = V6::Constant(1, 0.1);
   R6 R = R6::Constant(1, 1, -10.0);  // S = P33 − 10 < 0
-  ErrorMatrix P = P0, tmp;
+  ErrorMatrix P = P0;
   ErrorVector dx = ErrorVector::Zero(n);
-  EXPECT_FALSE(fusion::joseph_update(P, H, r, R, dx, tmp));
+  EXPECT_FALSE(fusion::joseph_update(P, H, r, R, dx));
   EXPECT_EQ((P - P0).cwiseAbs().maxCoeff(), 0.0);  // P untouched
 }
 
