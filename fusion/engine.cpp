@@ -20,6 +20,7 @@
 #include "gnss/least_squares.hpp"
 #include "ins/alignment.hpp"
 #include "ins/mechanization.hpp"
+#include "ins/saturation.hpp"
 
 namespace pednav::fusion {
 namespace {
@@ -183,6 +184,14 @@ class Filter {
     const ins::NavState after = ins::mechanize(x_.nav, inc);
     ins::DiscreteErrorModel& m = model_;
     ins::interval_error_model(layout_, spec_, x_.nav, after, inc, m);
+    if (saturation_noise_) {  // reconstructed clipped samples in this interval (docs/ins.md eq. 6.4)
+      const Eigen::Matrix3d R = x_.nav.q_e_b.toRotationMatrix();
+      m.Qd.block<3, 3>(ins::kAtt.offset, ins::kAtt.offset) += R * sat_att_var_b_.asDiagonal() * R.transpose();
+      m.Qd.block<3, 3>(ins::kVel.offset, ins::kVel.offset) += R * sat_vel_var_b_.asDiagonal() * R.transpose();
+      sat_att_var_b_.setZero();
+      sat_vel_var_b_.setZero();
+      saturation_noise_ = false;
+    }
     const double dt = inc.dt_s;
     if (o_.mode == Mode::kTightlyCoupled) {
       const int d = drift_block_.offset;
@@ -213,6 +222,13 @@ class Filter {
     if (recording_) interval_.predict(Phi_sparse_);
     covariance_predict(P_, Phi_sparse_, m.Qd, tmp_);
     x_.nav = after;
+  }
+
+  /// The error a reconstructed saturated run leaves (variance [rad²] of a gyro run's angle or [m²/s²] of an
+  /// accelerometer run's velocity, about/along body axis `axis`): process noise of the next prediction.
+  void add_saturation_noise(bool gyro, int axis, double variance) {
+    (gyro ? sat_att_var_b_ : sat_vel_var_b_)(axis) += variance;
+    saturation_noise_ = true;
   }
 
   // Joseph-form update with residuals r (measured - predicted), Jacobian H and noise covariance R;
@@ -372,6 +388,9 @@ class Filter {
   ins::Block drift_block_{0, 0};
   ins::InsState x_;
   ins::DiscreteErrorModel model_;  // Φ, Q_d of the current step (reused: no per-step construction)
+  Vector3d sat_att_var_b_ = Vector3d::Zero();  // pending saturation noise (add_saturation_noise), body axes
+  Vector3d sat_vel_var_b_ = Vector3d::Zero();
+  bool saturation_noise_ = false;
   ErrorMatrix P_;
   ErrorMatrix tmp_;
   std::vector<double> clock_m_;
@@ -425,6 +444,12 @@ class Runner {
     size_t max_sats = 0;
     if (in.rover) {
       for (const auto& e : *in.rover) max_sats = std::max(max_sats, e.sats.size());
+    }
+    if (o.repair_saturation && in.imu) {
+      ins::SaturationOptions so;
+      so.gyro_range_radps = o.spec.gyro_range;
+      so.accel_range_mps2 = o.spec.accel_range;
+      saturation_ = ins::repair_saturation(*in.imu, so);
     }
     re_.sats.reserve(max_sats);
     rows_.reserve(2 * max_sats);
@@ -607,8 +632,31 @@ class Runner {
       milestone_m *= 2.0;
       return po.at_milestone(result, reached);
     };
+    // Saturated samples (docs/ins.md §6): the repaired copies replace them; each run's σ goes into the filter
+    // with the run's last sample.
+    const auto& sat_samples = saturation_.samples;
+    const auto& sat_runs = saturation_.runs;
+    size_t sat_sample = 0, sat_run = 0;
+    for (const auto& r : sat_runs) {
+      if (r.last < start) continue;
+      ++sum.saturated_runs;
+      if (r.reconstructed) ++sum.saturated_runs_reconstructed;
+      if (r.gyro) sum.saturation_max_added_deg = std::max(sum.saturation_max_added_deg, std::abs(r.added) * 180.0 / M_PI);
+    }
+    for (const auto& s : sat_samples) sum.saturated_samples += s.index >= start ? 1 : 0;
+    sum.saturation_notes = saturation_.notes;
+    ins::ImuSample repaired;
     for (; sample_index < samples.size(); ++sample_index) {
-      const ins::ImuSample& raw = samples[sample_index];
+      const ins::ImuSample* raw_ptr = &samples[sample_index];
+      while (sat_sample < sat_samples.size() && sat_samples[sat_sample].index < sample_index) ++sat_sample;
+      if (sat_sample < sat_samples.size() && sat_samples[sat_sample].index == sample_index) {
+        repaired.t = raw_ptr->t;
+        repaired.omega_ib_b = sat_samples[sat_sample].omega_ib_b;
+        repaired.f_ib_b = sat_samples[sat_sample].f_ib_b;
+        raw_ptr = &repaired;
+      }
+      while (sat_run < sat_runs.size() && sat_runs[sat_run].last < sample_index) ++sat_run;
+      const ins::ImuSample& raw = *raw_ptr;
       if (po.stop && raw.t > *po.stop) break;
       if (po.at_milestone && milestone_m > 0.0 && stop_walking()) break;
       if (!raw.omega_ib_b.allFinite() || !raw.f_ib_b.allFinite()) {
@@ -632,6 +680,10 @@ class Runner {
         if (steps) steps.emplace(o_.step_velocity);
       }
       ++sum.imu_samples;
+      for (; sat_run < sat_runs.size() && sat_runs[sat_run].last == sample_index; ++sat_run) {
+        const auto& r = sat_runs[sat_run];
+        f.add_saturation_noise(r.gyro, r.axis, r.sigma * r.sigma);
+      }
       const ins::ImuSample corrected = ins::correct_sample(raw, f.x().imu);
       integrator.push(corrected, on_increment);
       if (failed) break;
@@ -1090,6 +1142,7 @@ class Runner {
   const EngineOptions& o_;
   const std::vector<ins::ZuptDecision>& decisions_;
   const double w_test_threshold_;  // chi2(1) quantile at o_.fault_probability
+  ins::SaturationRepair saturation_;  // clipped samples repaired once per run (docs/ins.md §6)
   std::vector<gnss::BaseMatch> matches_;
   bool sd_ = false;
   FrameYaw frame_;

@@ -74,6 +74,10 @@ struct EngineOptions {
   /// anything observes the bias. true: the turn-on bias is a random constant and the instability a random walk of
   /// the same short-term PSD 2σ²/τ (no decay; conservative beyond τ). docs/error_state.md §3, docs/consistency.md §3.2.
   bool bias_random_walk = false;
+  /// Samples at the full scale of the spec's gyro_range / accel_range are reconstructed from their neighbours and
+  /// the filter gets the reconstruction's σ as process noise (ins/saturation.hpp, docs/ins.md §6). false: clipped
+  /// samples are integrated as they are.
+  bool repair_saturation = true;
   /// Code multipath as one unit-variance first-order Gauss-Markov state u_s per tracked satellite (docs/consistency.md
   /// §3): the code error gets σ_mp · u_s, σ_mp = multipath_sigma_m · 10^(max(0, cn0_ref − C/N0)/20) per receiver
   /// (rover and base in quadrature for SD). multipath_sigma_m = 0: no multipath states (code errors white).
@@ -150,6 +154,11 @@ struct EngineSummary {
   // by reason: samples: in.imu size = imu_samples_used + Σ imu_rejected + Σ imu_skipped; measurements (tc):
   // gnss_measurements = Σ code_used_rejected (incl. "used") + Σ gnss_skipped.
   long imu_samples_used = 0;                 ///< samples fed to the filter (from the first still period on)
+  long saturated_runs = 0;                   ///< runs of samples at the full scale on one axis (docs/ins.md §6)
+  long saturated_runs_reconstructed = 0;     ///< of those, reconstructed from their neighbours
+  long saturated_samples = 0;                ///< samples with any axis at the full scale
+  double saturation_max_added_deg = 0.0;     ///< largest angle a gyro run's reconstruction added [deg]
+  std::vector<std::string> saturation_notes; ///< a sensor whose data exceed its configured range (not checked)
   std::map<std::string, long> imu_rejected;  ///< "non_finite"
   std::map<std::string, long> imu_skipped;   ///< "before_first_still_period", "filter_diverged" (waiting to re-initialize)
   long gnss_measurements = 0;                ///< satellite observations in all rover epochs (tc)

@@ -126,6 +126,8 @@ std::string to_yaml(const RunConfig& c) {
     << c.scale_factors.states << YAML::Key << "gyro" << YAML::Value << c.scale_factors.gyro << YAML::EndMap;
   e << YAML::Key << "bias" << YAML::Value << YAML::BeginMap << YAML::Key << "model" << YAML::Value << c.bias.model
     << YAML::EndMap;
+  e << YAML::Key << "saturation" << YAML::Value << YAML::BeginMap << YAML::Key << "repair" << YAML::Value
+    << c.saturation.repair << YAML::EndMap;
   e << YAML::Key << "output" << YAML::Value << YAML::BeginMap << YAML::Key << "rate_hz" << YAML::Value
     << c.output.rate_hz << YAML::Key << "formats" << YAML::Value << YAML::Flow << c.output.formats << YAML::EndMap;
   e << YAML::EndMap;

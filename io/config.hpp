@@ -142,6 +142,11 @@ struct BiasConfig {
   std::string model = "gauss_markov";
 };
 
+/// `saturation:` section: samples at the IMU spec's full scale (ins/saturation.hpp, docs/ins.md §6).
+struct SaturationConfig {
+  bool repair = true;  ///< reconstruct clipped runs from their neighbours, their σ into the filter's process noise
+};
+
 /// `output:` section.
 struct OutputConfig {
   double rate_hz = 1.0;                      ///< solution rows per second
@@ -166,6 +171,7 @@ struct RunConfig {
   MultipathConfig multipath;
   ScaleFactorConfig scale_factors;
   BiasConfig bias;
+  SaturationConfig saturation;
 };
 
 /// Read and validate a run configuration; every problem is reported at once ("file:line: yaml.path: what").

@@ -105,6 +105,10 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
     YamlMap b = top.map("bias");
     b.choice("model", out.bias.model, {"gauss_markov", "random_walk"});
   }
+  {
+    YamlMap s = top.map("saturation");
+    s.boolean("repair", out.saturation.repair);
+  }
 }
 
 }  // namespace pednav::io

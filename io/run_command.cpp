@@ -138,6 +138,7 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.estimate_scale_factors = c.scale_factors.states;
   o.estimate_gyro_scale_factors = c.scale_factors.gyro;
   o.bias_random_walk = c.bias.model == "random_walk";
+  o.repair_saturation = c.saturation.repair;
   return o;
 }
 
@@ -264,7 +265,13 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
               {"gaps", imu->report.gaps},
               {"longest_gap_s", imu->report.longest_gap_s},
               {"samples_processed", sum.imu_samples},
-              {"rate_hz", imu->report.rate_hz}};
+              {"rate_hz", imu->report.rate_hz},
+              {"saturation", {{"repair", opt.repair_saturation},
+                              {"samples", sum.saturated_samples},
+                              {"runs", sum.saturated_runs},
+                              {"runs_reconstructed", sum.saturated_runs_reconstructed},
+                              {"max_added_angle_deg", sum.saturation_max_added_deg},
+                              {"notes", sum.saturation_notes}}}};
   j["mechanization_steps"] = sum.mechanization_steps;
   j["zupt"] = {{"detector", c.zupt.detector}, {"form", c.zupt.form}, {"updates", sum.zupt_updates},
                {"stance_samples", sum.zupt_samples}};

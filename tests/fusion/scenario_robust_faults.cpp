@@ -109,6 +109,7 @@ Expected<fusion::EngineResult> run(const Walk& w, const Inputs& in, const fusion
 struct Errors {
   double rms = 0, max = 0, max_from = 0;
   long n = 0;
+  double inside_3sigma = 0;  // fraction of outputs with both the north and the east error inside 3σ
 };
 
 Errors errors(const Walk& w, const fusion::EngineResult& r, GpsTime t_from) {
@@ -121,13 +122,17 @@ Errors errors(const Walk& w, const fusion::EngineResult& r, GpsTime t_from) {
         << out.t.to_string();
     const long i = std::lround((out.t - nav.front().t) * rate);
     if (i < 0 || i >= static_cast<long>(nav.size())) continue;
-    const double d = enu_from_ecef(out.nav.p_eb_e, nav[i].p_eb_e).head<2>().norm();
+    const Vector3d enu = enu_from_ecef(out.nav.p_eb_e, nav[i].p_eb_e);
+    const double d = enu.head<2>().norm();
+    if (std::abs(enu.y()) <= 3.0 * std::sqrt(out.cov_p_n(0, 0)) && std::abs(enu.x()) <= 3.0 * std::sqrt(out.cov_p_n(1, 1)))
+      e.inside_3sigma += 1.0;
     ss += d * d;
     e.max = std::max(e.max, d);
     if (out.t >= t_from) e.max_from = std::max(e.max_from, d);
     ++e.n;
   }
   e.rms = e.n ? std::sqrt(ss / static_cast<double>(e.n)) : 0.0;
+  if (e.n) e.inside_3sigma /= static_cast<double>(e.n);
   return e;
 }
 
@@ -174,6 +179,51 @@ TEST(RobustGnssFault, NoFaultBaselineIsAccurateAndAccountsForEveryInput) {
   EXPECT_TRUE(r->summary.covariance_healthy) << r->summary.health_message;
   EXPECT_EQ(r->summary.reinitializations, 0);
   expect_accounting(in, r->summary);
+}
+
+// The walk's gyro clips (the Crista's 300 °/s against swing peaks of 457 °/s: 297 runs of up to 10 samples on the
+// across-foot axis). The runs are reconstructed from their neighbours with a σ in the process noise (docs/ins.md §6):
+// without that the lost pitch of every swing makes the forward solution worse and its σ dishonest, and estimated
+// accelerometer scale factors run away with it (docs/consistency.md §3.3).
+TEST(RobustImuFault, ClippedGyroRunsAreReconstructedAndTheSigmaStaysHonest) {
+  Walk& w = short_walk();
+  const Inputs in = inputs_of(w);
+  struct Case {
+    const char* name;
+    bool repair, accel_scale;
+  };
+  std::map<std::string, Errors> got;
+  for (const Case c : {Case{"repair", true, false}, Case{"no repair", false, false}, Case{"repair + accel scale", true, true},
+                       Case{"no repair + accel scale", false, true}}) {
+    fusion::EngineOptions o = w.options;
+    o.repair_saturation = c.repair;
+    o.estimate_scale_factors = c.accel_scale;
+    o.estimate_gyro_scale_factors = false;
+    auto r = run(w, in, o);
+    ASSERT_TRUE(r) << r.error().message;
+    const Errors e = errors(w, *r, GpsTime{});
+    std::printf("[ robust ] clipped gyro, %s: horizontal RMS %.2f m, %.1f %% inside 3 sigma; %ld runs, %ld reconstructed, "
+                "largest added angle %.1f deg\n",
+                c.name, e.rms, 100.0 * e.inside_3sigma, r->summary.saturated_runs, r->summary.saturated_runs_reconstructed,
+                r->summary.saturation_max_added_deg);
+    if (c.repair) {
+      EXPECT_GT(r->summary.saturated_runs, 250);
+      EXPECT_EQ(r->summary.saturated_runs_reconstructed, r->summary.saturated_runs);
+      EXPECT_GT(r->summary.saturated_samples, 2000);
+    } else {
+      EXPECT_EQ(r->summary.saturated_runs, 0);
+    }
+    got[c.name] = e;
+  }
+  // Measured: 0.94 m / 100 % with the repair, 1.24 m / 78 % without; with accelerometer scale states 1.03 m / 100 %
+  // against 3.76 m / 20 %. The unclipped walk (gyro range 2000 °/s): 0.93 m / 100 %.
+  EXPECT_LT(got["repair"].rms, 1.05);
+  EXPECT_GE(got["repair"].inside_3sigma, 0.97);
+  EXPECT_GT(got["no repair"].rms, got["repair"].rms + 0.15);
+  EXPECT_LT(got["no repair"].inside_3sigma, 0.9);
+  EXPECT_LT(got["repair + accel scale"].rms, 1.2);
+  EXPECT_GE(got["repair + accel scale"].inside_3sigma, 0.97);
+  EXPECT_GT(got["no repair + accel scale"].rms, 2.0);
 }
 
 TEST(RobustGnssFault, ReceiverClockJumpOf1msResetsTheClock) {
