@@ -50,6 +50,7 @@ struct McOptions {
   bool scale_states = false;       ///< filter scale-factor states (the scenario's IMU spec)
   bool accel_scale_states = false; ///< filter accelerometer scale-factor states only
   bool bias_random_walk = false;   ///< filter bias model: turn-on constant + random walk (`bias: {model: random_walk}`)
+  bool saturation_repair = true;   ///< reconstruct clipped IMU runs (`saturation: {repair: false}` to switch off)
 };
 
 // One finished run (what runs.csv shows), with its per-epoch errors.
@@ -118,6 +119,7 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
   if (mo.scale_states || mo.accel_scale_states) o.estimate_scale_factors = true;
   if (mo.accel_scale_states) o.estimate_gyro_scale_factors = false;
   if (mo.bias_random_walk) o.bias_random_walk = true;
+  o.repair_saturation = mo.saturation_repair;
   if (mo.multipath_states) {
     // The filter's multipath model = the simulator's (docs/consistency.md §3).
     o.multipath_sigma_m = sc.gnss.multipath_sigma_m;
@@ -419,6 +421,8 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
       ->excludes("--scale-states");
   cmd->add_flag("--bias-random-walk", mo->bias_random_walk,
                 "Filter bias model: turn-on bias constant + random walk (`bias: {model: random_walk}`)");
+  cmd->add_flag("!--no-saturation-repair", mo->saturation_repair,
+                "Integrate clipped IMU samples as they are (`saturation: {repair: false}`)");
   cmd->add_flag("--step-velocity", mo->step_velocity, "Seed 000 step-averaged velocity aiding");
   cmd->add_option("--leg-length-m", mo->leg_length_m, "Inverted-pendulum length l of the step-length model [m]")
       ->check(CLI::Range(0.05, 3.0));
