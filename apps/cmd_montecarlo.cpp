@@ -50,6 +50,8 @@ struct McOptions {
   bool scale_states = false;       ///< filter scale-factor states (the scenario's IMU spec)
   bool accel_scale_states = false; ///< filter accelerometer scale-factor states only
   bool bias_random_walk = false;   ///< filter bias model: turn-on constant + random walk (`bias: {model: random_walk}`)
+  bool no_scale_states = false;    ///< no scale-factor states (the mode-ins default; tc has accelerometer ones)
+  bool gauss_markov_bias = false;  ///< Gauss-Markov bias model (the mode-ins default; tc uses the random walk)
   bool saturation_repair = true;   ///< reconstruct clipped IMU runs (`saturation: {repair: false}` to switch off)
 };
 
@@ -115,6 +117,8 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
   c.imu.spec = sc.imu.spec;
   c.zupt.form = mo.zupt_form;
   c.smoother_enabled = mo.smoother;
+  if (mo.no_scale_states) c.scale_factors.states = false;
+  if (mo.gauss_markov_bias) c.bias.model = "gauss_markov";
   fusion::EngineOptions o = io::engine_options(c);
   if (mo.scale_states || mo.accel_scale_states) o.estimate_scale_factors = true;
   if (mo.accel_scale_states) o.estimate_gyro_scale_factors = false;
@@ -420,7 +424,14 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
                 "Filter accelerometer scale-factor states only (`scale_factors: {states: true, gyro: false}`)")
       ->excludes("--scale-states");
   cmd->add_flag("--bias-random-walk", mo->bias_random_walk,
-                "Filter bias model: turn-on bias constant + random walk (`bias: {model: random_walk}`)");
+                "Filter bias model: turn-on bias constant + random walk (`bias: {model: random_walk}`; tc default)");
+  cmd->add_flag("--no-scale-states", mo->no_scale_states,
+                "No scale-factor states (`scale_factors: {states: false}`; mode tc has accelerometer ones by default)")
+      ->excludes("--scale-states")
+      ->excludes("--accel-scale-states");
+  cmd->add_flag("--gauss-markov-bias", mo->gauss_markov_bias,
+                "Filter bias model: one Gauss-Markov state per axis (`bias: {model: gauss_markov}`; mode ins default)")
+      ->excludes("--bias-random-walk");
   cmd->add_flag("!--no-saturation-repair", mo->saturation_repair,
                 "Integrate clipped IMU samples as they are (`saturation: {repair: false}`)");
   cmd->add_flag("--step-velocity", mo->step_velocity, "Seed 000 step-averaged velocity aiding");

@@ -72,6 +72,17 @@ Expected<RunConfig> load_run_config(const std::string& path) {
   return parse_run_config(src->text, path, src->base_dir);
 }
 
+// docs/consistency.md §3.3: in mode tc the GNSS observes the accelerometer scale factors and the turn-on biases, so
+// the filter gets the accelerometer scale-factor states and the random-walk bias model; in mode ins it does not.
+ImuErrorModelChoice imu_error_model_choice(const RunConfig& c) {
+  const bool tc = c.mode == "tc";
+  ImuErrorModelChoice m;
+  m.scale_states = c.scale_factors.states.value_or(tc);
+  m.gyro_scale_states = m.scale_states && (c.scale_factors.states ? c.scale_factors.gyro : false);
+  m.bias_random_walk = c.bias.model == "auto" ? tc : c.bias.model == "random_walk";
+  return m;
+}
+
 std::string to_yaml(const RunConfig& c) {
   YAML::Emitter e;
   e << YAML::BeginMap;
@@ -122,10 +133,12 @@ std::string to_yaml(const RunConfig& c) {
     << YAML::Value << c.multipath.tau_s << YAML::Key << "cn0_ref_dbhz" << YAML::Value << c.multipath.cn0_ref_dbhz
     << YAML::Key << "slots" << YAML::Value << c.multipath.slots << YAML::Key << "reset_gap_s" << YAML::Value
     << c.multipath.reset_gap_s << YAML::EndMap;
+  const ImuErrorModelChoice m = imu_error_model_choice(c);  // written resolved: what this run's filter used
   e << YAML::Key << "scale_factors" << YAML::Value << YAML::BeginMap << YAML::Key << "states" << YAML::Value
-    << c.scale_factors.states << YAML::Key << "gyro" << YAML::Value << c.scale_factors.gyro << YAML::EndMap;
-  e << YAML::Key << "bias" << YAML::Value << YAML::BeginMap << YAML::Key << "model" << YAML::Value << c.bias.model
+    << m.scale_states << YAML::Key << "gyro" << YAML::Value << (m.scale_states ? m.gyro_scale_states : c.scale_factors.gyro)
     << YAML::EndMap;
+  e << YAML::Key << "bias" << YAML::Value << YAML::BeginMap << YAML::Key << "model" << YAML::Value
+    << (m.bias_random_walk ? "random_walk" : "gauss_markov") << YAML::EndMap;
   e << YAML::Key << "saturation" << YAML::Value << YAML::BeginMap << YAML::Key << "repair" << YAML::Value
     << c.saturation.repair << YAML::EndMap;
   e << YAML::Key << "output" << YAML::Value << YAML::BeginMap << YAML::Key << "rate_hz" << YAML::Value

@@ -131,15 +131,18 @@ struct MultipathConfig {
 
 /// `scale_factors:` section: IMU scale-factor states (the spec's *_scale_sigma, docs/consistency.md §3).
 struct ScaleFactorConfig {
-  bool states = false;  ///< off: in ins mode they degrade INS/ZUPT (docs/consistency.md §3)
-  bool gyro = true;     ///< with states: also the gyro block (false: accelerometer scale factors only, §3.2)
+  /// unset (the default, or `auto`): accelerometer scale factors in mode tc, none in mode ins — without GNSS nothing
+  /// separates a scale factor from the attitude and velocity errors the ZUPTs see (docs/consistency.md §3.3).
+  std::optional<bool> states;
+  bool gyro = true;     ///< with `states: true`: also the gyro block (false: accelerometer scale factors only, §3.2)
 };
 
 /// `bias:` section: how the filter models the IMU biases (docs/consistency.md §3.2).
 struct BiasConfig {
   /// gauss_markov: one GM state per axis (instability σ, τ) started at the turn-on σ; random_walk: the turn-on
-  /// bias a random constant, the instability a random walk of PSD 2σ²/τ.
-  std::string model = "gauss_markov";
+  /// bias a random constant, the instability a random walk of PSD 2σ²/τ; auto: random_walk in mode tc,
+  /// gauss_markov in mode ins (docs/consistency.md §3.3).
+  std::string model = "auto";
 };
 
 /// `saturation:` section: samples at the IMU spec's full scale (ins/saturation.hpp, docs/ins.md §6).
@@ -173,6 +176,14 @@ struct RunConfig {
   BiasConfig bias;
   SaturationConfig saturation;
 };
+
+/// The IMU error model the filter gets for a configuration (the `auto` defaults resolved by mode).
+struct ImuErrorModelChoice {
+  bool scale_states = false;      ///< scale-factor states
+  bool gyro_scale_states = false; ///< with scale_states: the gyro block too
+  bool bias_random_walk = false;  ///< bias: turn-on constant + random walk (else Gauss-Markov)
+};
+ImuErrorModelChoice imu_error_model_choice(const RunConfig& c);
 
 /// Read and validate a run configuration; every problem is reported at once ("file:line: yaml.path: what").
 Expected<RunConfig> load_run_config(const std::string& path);

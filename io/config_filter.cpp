@@ -98,12 +98,17 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
   }
   {
     YamlMap s = top.map("scale_factors");
-    s.boolean("states", out.scale_factors.states);
+    if (s.has("states")) {
+      std::string v;
+      s.choice("states", v, {"auto", "true", "false"});
+      if (v == "true") out.scale_factors.states = true;
+      if (v == "false") out.scale_factors.states = false;
+    }
     s.boolean("gyro", out.scale_factors.gyro);
   }
   {
     YamlMap b = top.map("bias");
-    b.choice("model", out.bias.model, {"gauss_markov", "random_walk"});
+    b.choice("model", out.bias.model, {"auto", "gauss_markov", "random_walk"});
   }
   {
     YamlMap s = top.map("saturation");

@@ -135,9 +135,10 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.multipath_cn0_ref_dbhz = c.multipath.cn0_ref_dbhz;
   o.multipath_slots = c.multipath.slots;
   o.multipath_reset_gap_s = c.multipath.reset_gap_s;
-  o.estimate_scale_factors = c.scale_factors.states;
-  o.estimate_gyro_scale_factors = c.scale_factors.gyro;
-  o.bias_random_walk = c.bias.model == "random_walk";
+  const ImuErrorModelChoice m = imu_error_model_choice(c);
+  o.estimate_scale_factors = m.scale_states;
+  o.estimate_gyro_scale_factors = m.gyro_scale_states;
+  o.bias_random_walk = m.bias_random_walk;
   o.repair_saturation = c.saturation.repair;
   return o;
 }

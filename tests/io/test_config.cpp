@@ -102,20 +102,55 @@ TEST(Config, AccelOnlyScaleStatesAndBiasModelKeys) {
   auto cfg = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\nscale_factors:\n  states: true\n  gyro: false\n"
                    "bias:\n  model: random_walk\n");
   ASSERT_TRUE(cfg) << cfg.error().message;
-  EXPECT_TRUE(cfg->scale_factors.states);
+  EXPECT_EQ(cfg->scale_factors.states, std::optional<bool>(true));
   EXPECT_FALSE(cfg->scale_factors.gyro);
   EXPECT_EQ(cfg->bias.model, "random_walk");
   auto again = parse(to_yaml(*cfg));  // config.resolved.yaml reads back to the same values
   ASSERT_TRUE(again) << again.error().message;
   EXPECT_FALSE(again->scale_factors.gyro);
   EXPECT_EQ(again->bias.model, "random_walk");
-  auto defaults = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\n");
-  ASSERT_TRUE(defaults) << defaults.error().message;
-  EXPECT_TRUE(defaults->scale_factors.gyro);
-  EXPECT_EQ(defaults->bias.model, "gauss_markov");
   auto bad = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\nbias:\n  model: rw\n");
   ASSERT_FALSE(bad);
-  EXPECT_THAT(bad.error().message, HasSubstr("bias.model: expected one of {gauss_markov, random_walk}, got 'rw'"));
+  EXPECT_THAT(bad.error().message,
+              HasSubstr("bias.model: expected one of {auto, gauss_markov, random_walk}, got 'rw'"));
+  bad = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\nscale_factors:\n  states: maybe\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("scale_factors.states: expected one of {auto, true, false}, got 'maybe'"));
+}
+
+// The defaults depend on the mode (docs/consistency.md §3.3): tc gets accelerometer scale-factor states and the
+// random-walk bias model, ins neither; explicit keys win; the resolved configuration writes what was used.
+TEST(Config, ImuErrorModelDefaultsDependOnTheMode) {
+  const std::string files = "rover_obs: r.obs\nnav: n.nav\nimu: {file: i.csv, format: pyshoe, spec: crista}\n";
+  auto tc = parse("mode: tc\n" + files);
+  ASSERT_TRUE(tc) << tc.error().message;
+  EXPECT_FALSE(tc->scale_factors.states.has_value());
+  EXPECT_EQ(tc->bias.model, "auto");
+  ImuErrorModelChoice m = imu_error_model_choice(*tc);
+  EXPECT_TRUE(m.scale_states);
+  EXPECT_FALSE(m.gyro_scale_states);
+  EXPECT_TRUE(m.bias_random_walk);
+  auto ins = parse("mode: ins\n" + files);
+  ASSERT_TRUE(ins) << ins.error().message;
+  m = imu_error_model_choice(*ins);
+  EXPECT_FALSE(m.scale_states);
+  EXPECT_FALSE(m.bias_random_walk);
+  auto tc_off = parse("mode: tc\n" + files + "scale_factors: {states: false}\nbias: {model: gauss_markov}\n");
+  ASSERT_TRUE(tc_off) << tc_off.error().message;
+  m = imu_error_model_choice(*tc_off);
+  EXPECT_FALSE(m.scale_states);
+  EXPECT_FALSE(m.bias_random_walk);
+  auto ins_on = parse("mode: ins\n" + files + "scale_factors: {states: true}\nbias: {model: random_walk}\n");
+  ASSERT_TRUE(ins_on) << ins_on.error().message;
+  m = imu_error_model_choice(*ins_on);
+  EXPECT_TRUE(m.scale_states);
+  EXPECT_TRUE(m.gyro_scale_states);  // an explicit `states: true` keeps gyro's own default (true)
+  EXPECT_TRUE(m.bias_random_walk);
+  auto again = parse(to_yaml(*tc));
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_EQ(again->scale_factors.states, std::optional<bool>(true));
+  EXPECT_FALSE(again->scale_factors.gyro);
+  EXPECT_EQ(again->bias.model, "random_walk");
 }
 
 TEST(Config, MultipathAndScaleFactorStateKeys) {
@@ -127,13 +162,13 @@ TEST(Config, MultipathAndScaleFactorStateKeys) {
   EXPECT_DOUBLE_EQ(cfg->multipath.sigma_m, 0.5);
   EXPECT_DOUBLE_EQ(cfg->multipath.tau_s, 30.0);
   EXPECT_EQ(cfg->multipath.slots, 10);
-  EXPECT_TRUE(cfg->scale_factors.states);
+  EXPECT_EQ(cfg->scale_factors.states, std::optional<bool>(true));
   // The resolved configuration carries them (config.resolved.yaml reads back to the same values).
   auto again = parse(to_yaml(*cfg));
   ASSERT_TRUE(again) << again.error().message;
   EXPECT_TRUE(again->multipath.states);
   EXPECT_EQ(again->multipath.slots, 10);
-  EXPECT_TRUE(again->scale_factors.states);
+  EXPECT_EQ(again->scale_factors.states, std::optional<bool>(true));
   auto bad = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\nmultipath:\n  slots: 40\n  tau_s: 0\n");
   ASSERT_FALSE(bad);
   EXPECT_THAT(bad.error().message, HasSubstr("multipath.slots: value 40 is out of range"));
