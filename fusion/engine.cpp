@@ -184,7 +184,7 @@ class Filter {
     const ins::NavState after = ins::mechanize(x_.nav, inc);
     ins::DiscreteErrorModel& m = model_;
     ins::interval_error_model(layout_, spec_, x_.nav, after, inc, m);
-    if (saturation_noise_) {  // reconstructed clipped samples in this interval (docs/ins.md eq. 6.4)
+    if (saturation_noise_) {  // reconstructed clipped samples in this interval (docs/ins.md eq. 9.4)
       const Eigen::Matrix3d R = x_.nav.q_e_b.toRotationMatrix();
       m.Qd.block<3, 3>(ins::kAtt.offset, ins::kAtt.offset) += R * sat_att_var_b_.asDiagonal() * R.transpose();
       m.Qd.block<3, 3>(ins::kVel.offset, ins::kVel.offset) += R * sat_vel_var_b_.asDiagonal() * R.transpose();
@@ -632,7 +632,7 @@ class Runner {
       milestone_m *= 2.0;
       return po.at_milestone(result, reached);
     };
-    // Saturated samples (docs/ins.md §6): the repaired copies replace them; each run's σ goes into the filter
+    // Saturated samples (docs/ins.md §9): the repaired copies replace them; each run's σ goes into the filter
     // with the run's last sample.
     const auto& sat_samples = saturation_.samples;
     const auto& sat_runs = saturation_.runs;
@@ -1142,7 +1142,7 @@ class Runner {
   const EngineOptions& o_;
   const std::vector<ins::ZuptDecision>& decisions_;
   const double w_test_threshold_;  // chi2(1) quantile at o_.fault_probability
-  ins::SaturationRepair saturation_;  // clipped samples repaired once per run (docs/ins.md §6)
+  ins::SaturationRepair saturation_;  // clipped samples repaired once per run (docs/ins.md §9)
   std::vector<gnss::BaseMatch> matches_;
   bool sd_ = false;
   FrameYaw frame_;

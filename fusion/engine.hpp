@@ -75,7 +75,7 @@ struct EngineOptions {
   /// the same short-term PSD 2σ²/τ (no decay; conservative beyond τ). docs/error_state.md §3, docs/consistency.md §3.2.
   bool bias_random_walk = false;
   /// Samples at the full scale of the spec's gyro_range / accel_range are reconstructed from their neighbours and
-  /// the filter gets the reconstruction's σ as process noise (ins/saturation.hpp, docs/ins.md §6). false: clipped
+  /// the filter gets the reconstruction's σ as process noise (ins/saturation.hpp, docs/ins.md §9). false: clipped
   /// samples are integrated as they are.
   bool repair_saturation = true;
   /// Code multipath as one unit-variance first-order Gauss-Markov state u_s per tracked satellite (docs/consistency.md
@@ -154,7 +154,7 @@ struct EngineSummary {
   // by reason: samples: in.imu size = imu_samples_used + Σ imu_rejected + Σ imu_skipped; measurements (tc):
   // gnss_measurements = Σ code_used_rejected (incl. "used") + Σ gnss_skipped.
   long imu_samples_used = 0;                 ///< samples fed to the filter (from the first still period on)
-  long saturated_runs = 0;                   ///< runs of samples at the full scale on one axis (docs/ins.md §6)
+  long saturated_runs = 0;                   ///< runs of samples at the full scale on one axis (docs/ins.md §9)
   long saturated_runs_reconstructed = 0;     ///< of those, reconstructed from their neighbours
   long saturated_samples = 0;                ///< samples with any axis at the full scale
   double saturation_max_added_deg = 0.0;     ///< largest angle a gyro run's reconstruction added [deg]

@@ -42,10 +42,10 @@ class PolyFit {
 
 }  // namespace
 
-// docs/ins.md §6. For a run k = first..last clipped at ±r on one axis, with n unclipped samples on each side:
-//   x̂(t) = p₄(t), the degree-4 least-squares polynomial through the 2n neighbours                     (6.1)
-//   v_k = sign · min(max(sign · x̂(t_k), r), c_max r),  added A = Σ_k (|v_k| − r) Δt_k                  (6.2)
-//   σ_A = max(κ A, |A − A₂|), A₂ from the degree-2 fit through the n − 1 nearest neighbours per side   (6.3)
+// docs/ins.md §9. For a run k = first..last clipped at ±r on one axis, with n unclipped samples on each side:
+//   x̂(t) = p₄(t), the degree-4 least-squares polynomial through the 2n neighbours                     (9.1)
+//   v_k = sign · min(max(sign · x̂(t_k), r), c_max r),  added A = Σ_k (|v_k| − r) Δt_k                  (9.2)
+//   σ_A = max(κ A, |A − A₂|), A₂ from the degree-2 fit through the n − 1 nearest neighbours per side   (9.3)
 // with Δt_k = (t_{k+1} − t_{k−1}) / 2. A run that cannot be reconstructed keeps its clipped values and gets
 // σ_A = r T / 2 (the excess rate is taken as up to the range itself over the run's duration T).
 SaturationRepair repair_saturation(const std::vector<ImuSample>& samples, const SaturationOptions& o) {

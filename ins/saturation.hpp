@@ -1,5 +1,5 @@
 // Saturated (clipped) IMU samples: find the runs of samples held at the full scale, reconstruct the clipped part
-// from the samples around each run, and say how uncertain the reconstruction is (docs/ins.md §6).
+// from the samples around each run, and say how uncertain the reconstruction is (docs/ins.md §9).
 //
 // A foot's swing can exceed a MEMS gyro's range (the Crista's 300 °/s: the across-foot rate of a 1.2 m/s walk peaks
 // near 460 °/s). The clipped samples lose a few degrees of pitch per swing; the filter's error model does not know
@@ -26,7 +26,7 @@ struct SaturationOptions {
   int fit_samples = 4;             ///< unclipped samples used on each side of a run
   double max_run_s = 0.25;         ///< longer runs are not reconstructed (the extrapolation is not trusted)
   double max_peak_factor = 3.0;    ///< reconstructed values are capped at this x range
-  double sigma_fraction = 0.25;    ///< σ of a run's added angle/velocity: at least this fraction of it (eq. 6.3)
+  double sigma_fraction = 0.25;    ///< σ of a run's added angle/velocity: at least this fraction of it (eq. 9.3)
 };
 
 /// One run of consecutive samples clipped on one axis of one sensor.
@@ -53,7 +53,7 @@ struct SaturationRepair {
   std::vector<std::string> notes;
 };
 
-/// Find and repair the saturated samples of a time-ordered log (docs/ins.md eq. 6.1-6.3).
+/// Find and repair the saturated samples of a time-ordered log (docs/ins.md eq. 9.1-9.3).
 SaturationRepair repair_saturation(const std::vector<ImuSample>& samples, const SaturationOptions& options);
 
 }  // namespace pednav::ins

@@ -145,7 +145,7 @@ struct BiasConfig {
   std::string model = "auto";
 };
 
-/// `saturation:` section: samples at the IMU spec's full scale (ins/saturation.hpp, docs/ins.md §6).
+/// `saturation:` section: samples at the IMU spec's full scale (ins/saturation.hpp, docs/ins.md §9).
 struct SaturationConfig {
   bool repair = true;  ///< reconstruct clipped runs from their neighbours, their σ into the filter's process noise
 };

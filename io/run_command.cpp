@@ -239,6 +239,12 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
   smoothed_rows.reserve(res->smoothed.size());
   for (const auto& e : res->smoothed) smoothed_rows.push_back(solution_row(e));
   if (!sum.smoother_message.empty()) spdlog::warn("{} (only the forward solution is written)", sum.smoother_message);
+  for (const auto& note : sum.saturation_notes) spdlog::warn("{}: {}", c.imu.file, note);
+  if (sum.saturated_runs > 0) {
+    spdlog::info("{}: {} runs of saturated samples ({} samples), {} reconstructed (largest added angle {:.1f} deg)",
+                 c.imu.file, sum.saturated_runs, sum.saturated_samples, sum.saturated_runs_reconstructed,
+                 sum.saturation_max_added_deg);
+  }
   if (sum.smoothed) {
     if (auto ok = write_solution_csv((out / "smoothed.csv").string(), smoothed_rows); !ok) return ok.error();
     if (auto ok = write_solution_pos((out / "solution_smoothed.pos").string(), smoothed_rows,

@@ -182,7 +182,7 @@ TEST(RobustGnssFault, NoFaultBaselineIsAccurateAndAccountsForEveryInput) {
 }
 
 // The walk's gyro clips (the Crista's 300 °/s against swing peaks of 457 °/s: 297 runs of up to 10 samples on the
-// across-foot axis). The runs are reconstructed from their neighbours with a σ in the process noise (docs/ins.md §6):
+// across-foot axis). The runs are reconstructed from their neighbours with a σ in the process noise (docs/ins.md §9):
 // without that the lost pitch of every swing makes the forward solution worse and its σ dishonest, and estimated
 // accelerometer scale factors run away with it (docs/consistency.md §3.3).
 TEST(RobustImuFault, ClippedGyroRunsAreReconstructedAndTheSigmaStaysHonest) {

@@ -1,4 +1,4 @@
-// Saturated IMU samples (ins/saturation.hpp, docs/ins.md §6): runs found per axis and sensor, reconstruction from
+// Saturated IMU samples (ins/saturation.hpp, docs/ins.md §9): runs found per axis and sensor, reconstruction from
 // the neighbours (exact for a quartic, close for swing-like peaks), its σ, and the cases that must not be repaired.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -66,7 +66,7 @@ TEST(Saturation, AQuarticPeakIsReconstructedExactly) {
     EXPECT_EQ(s.f_ib_b, log.clipped[s.index].f_ib_b);
   }
   EXPECT_NEAR(run.added, log.missing, 1e-9);
-  EXPECT_GE(run.sigma, 0.25 * run.added - 1e-15);  // eq. 6.3: at least κ A
+  EXPECT_GE(run.sigma, 0.25 * run.added - 1e-15);  // eq. 9.3: at least κ A
 }
 
 TEST(Saturation, SwingLikePeaksAreReconstructedWithinTheirSigma) {
