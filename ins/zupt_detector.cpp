@@ -87,6 +87,53 @@ std::vector<std::string> ZuptDetectorOptions::problems() const {
   return p;
 }
 
+// docs/zupt.md §3: keep the contiguous core of each stance run where the SHOE statistic is below
+// max(γ, factor · its minimum in the run), widened to min_stance_s.
+void refine_hmm_stances(std::vector<ZuptDecision>& d, const std::vector<ImuSample>& s, const std::vector<double>& t,
+                        const ZuptDetectorOptions& o) {
+  auto next_stance_start = [&](std::size_t j) {  // first stance sample after the run ending at j (or the end)
+    std::size_t k = j + 1;
+    while (k < s.size() && !d[k].stance) ++k;
+    return k;
+  };
+  std::size_t prev_end = 0;  // one past the previous (refined) stance run
+  for (std::size_t i = 0; i < s.size();) {
+    if (!d[i].stance) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j + 1 < s.size() && d[j + 1].stance) ++j;
+    std::size_t m = i;
+    for (std::size_t k = i; k <= j; ++k) {
+      if (t[k] < t[m]) m = k;
+    }
+    const double thr = std::max(o.shoe_threshold, o.hmm_refine_factor * t[m]);
+    std::size_t a = m, b = m;
+    while (a > i && t[a - 1] < thr) --a;
+    while (b < j && t[b + 1] < thr) ++b;
+    // Refinement never removes a step: the core is widened (towards the smaller T) to min_stance_s — beyond the
+    // decoded D run when that is shorter and is a whole step of its own: framed by heel strike and push-off, with
+    // a swing since the previous stance (a fast step whose stance is one observation) — but never into the
+    // neighbouring stance runs.
+    bool swing_before = false;
+    for (std::size_t k = prev_end; k < i && !swing_before; ++k) swing_before = d[k].gait_state == kSwing;
+    const bool full_cycle = swing_before && i > 0 && j + 1 < s.size() &&
+                            d[i - 1].gait_state == kHeelStrike && d[j + 1].gait_state == kPushOff;
+    const std::size_t lo = full_cycle ? prev_end : i, hi = full_cycle ? next_stance_start(j) : j + 1;
+    while (s[b].t - s[a].t < o.min_stance_s && (a > lo || b + 1 < hi)) {
+      if (b + 1 >= hi || (a > lo && t[a - 1] < t[b + 1])) {
+        --a;
+      } else {
+        ++b;
+      }
+    }
+    for (std::size_t k = std::min(a, i); k <= std::max(b, j); ++k) d[k].stance = k >= a && k <= b;
+    prev_end = b + 1;
+    i = std::max(b, j) + 1;
+  }
+}
+
 HmmDetection detect_gait_hmm(const std::vector<ImuSample>& s, const ZuptDetectorOptions& o) {
   HmmDetection h;
   h.decisions.resize(s.size());
@@ -166,37 +213,8 @@ HmmDetection detect_gait_hmm(const std::vector<ImuSample>& s, const ZuptDetector
       k = j + 1;
     }
   }
-  // Stance shortening with a gait-speed adaptive threshold: keep the contiguous core of each stance interval
-  // where the SHOE statistic is below max(γ, factor · its minimum in the interval).
-  if (o.hmm_refine_factor > 0) {
-    const std::vector<double> t = shoe_statistic(s, o);
-    for (std::size_t i = 0; i < s.size();) {
-      if (!h.decisions[i].stance) {
-        ++i;
-        continue;
-      }
-      std::size_t j = i;
-      while (j + 1 < s.size() && h.decisions[j + 1].stance) ++j;
-      std::size_t m = i;
-      for (std::size_t k = i; k <= j; ++k) {
-        if (t[k] < t[m]) m = k;
-      }
-      const double thr = std::max(o.shoe_threshold, o.hmm_refine_factor * t[m]);
-      std::size_t a = m, b = m;
-      while (a > i && t[a - 1] < thr) --a;
-      while (b < j && t[b + 1] < thr) ++b;
-      // Refinement never removes a step: the core is widened (towards the smaller T) to min_stance_s.
-      while (s[b].t - s[a].t < o.min_stance_s && (a > i || b < j)) {
-        if (b >= j || (a > i && t[a - 1] < t[b + 1])) {
-          --a;
-        } else {
-          ++b;
-        }
-      }
-      for (std::size_t k = i; k <= j; ++k) h.decisions[k].stance = k >= a && k <= b;
-      i = j + 1;
-    }
-  }
+  // Stance shortening with a gait-speed adaptive threshold (refine_hmm_stances).
+  if (o.hmm_refine_factor > 0) refine_hmm_stances(h.decisions, s, shoe_statistic(s, o), o);
   drop_short_runs(h.decisions, s, o.min_stance_s);
   drop_stances_right_after_push_off(h.decisions, s, o.hmm_min_swing_s);
   return h;

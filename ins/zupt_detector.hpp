@@ -76,6 +76,14 @@ struct ZuptDecision {
 /// stance interrupted by a flicker) are left alone.
 void drop_stances_right_after_push_off(std::vector<ZuptDecision>& d, const std::vector<ImuSample>& s, double min_s);
 
+/// HMM post-processing (docs/zupt.md §3): each stance run of `d` keeps only its contiguous core where the SHOE
+/// statistic `t` (one per sample) is below max(γ, hmm_refine_factor · its minimum in the run); a core shorter than
+/// min_stance_s is widened towards the smaller T — beyond the run only when the run is a whole step of its own
+/// (gait_state heel strike before it, push-off after it, a swing since the previous stance), and never into the
+/// neighbouring stance runs.
+void refine_hmm_stances(std::vector<ZuptDecision>& d, const std::vector<ImuSample>& s, const std::vector<double>& t,
+                        const ZuptDetectorOptions& o);
+
 /// The HMM detector's by-products (for `pednav zupt` and the documentation).
 struct HmmDetection {
   std::vector<ZuptDecision> decisions;  ///< one per sample

@@ -93,5 +93,26 @@ TEST(DataZuptHmm, LordStanceRightAfterPushOffIsDropped) {
   EXPECT_EQ(stance_intervals(detect_gait_hmm(c.samples, c.options).decisions, c.samples).size(), 27u);
 }
 
+// Issue 8: the HMM step count equals the footprint count on all four LORD hallway trials (stance intervals incl. the
+// start and end rest; footprints = GCP rows). #35 and #38 each have one fast step whose decoded stance is a single
+// observation (18.65 s and 39.68 s, 25-45 ms of D between heel strike and push-off): refine_hmm_stances widens it to
+// min_stance_s instead of losing it (before: 28 and 60).
+TEST(DataZuptHmm, LordStepCountEqualsTheFootprintsOnAllFourTrials) {
+  const std::vector<std::pair<std::string, size_t>> trials{{"31", 34}, {"34", 25}, {"35", 29}, {"38", 61}};
+  for (const auto& [n, footprints] : trials) {
+    PEDNAV_REQUIRE_DATA(test::shared_data("foot_lord_gcp_hallway/SensorConnectData_" + n + ".csv"));
+    HmmCase c;
+    ASSERT_NO_FATAL_FAILURE(load_hmm_case("lord_" + n, c));
+    const auto intervals = stance_intervals(detect_gait_hmm(c.samples, c.options).decisions, c.samples);
+    EXPECT_EQ(intervals.size(), footprints) << "LORD #" << n;
+    if (n == "35" || n == "38") {
+      const double t_step = n == "35" ? 18.65 : 39.68;
+      bool found = false;
+      for (const auto& [a, b] : intervals) found = found || (a < t_step + 0.05 && b > t_step - 0.05);
+      EXPECT_TRUE(found) << "LORD #" << n << ": no stance at " << t_step << " s";
+    }
+  }
+}
+
 }  // namespace
 }  // namespace pednav::ins

@@ -5,6 +5,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 
 namespace pednav::ins {
@@ -267,6 +269,50 @@ TEST(ZuptDetector, StanceRightAfterPushOffIsDropped) {
   d0[24].stance = true;
   drop_stances_right_after_push_off(d0, s, 0.0);
   EXPECT_TRUE(d0[24].stance);
+}
+
+// refine_hmm_stances: a decoded stance shorter than min_stance_s that is a whole step (heel strike before it, push-off
+// after it, a swing since the previous stance) is widened beyond its run to min_stance_s instead of being lost (the
+// LORD #35/#38 fast steps whose stance is one observation); one that is not (a D inside a heel strike, or a second
+// D in the same stance) stays inside its run and is then dropped as too short.
+TEST(ZuptDetector, ShortWholeStepIsWidenedOthersAreNot) {
+  //                  0         1         2         3         4         5         6         7
+  //                  0123456789012345678901234567890123456789012345678901234567890123456789012345678
+  const char* gait = "DDDDDDDDDDAAAABBBBBBBBBBBBCCCDDAAAABBBBBBBBBBCCCCDCCCCDDDDDDCCCDDAAAABBBB";
+  // D 0-9; A, B; C 26-28; D 29-30 (a whole step, 20 ms); A, B; C 45-48, D 49 (inside a heel strike), C 50-53;
+  // D 54-59; C 60-62, D 63-64 (no swing since the stance at 54-59); A, B.
+  std::vector<ImuSample> s;
+  std::vector<ZuptDecision> d;
+  std::vector<double> T;
+  for (int k = 0; gait[k] != '\0'; ++k) {
+    ImuSample x;
+    x.t = GpsTime::from_week_tow(0, 0.01 * k);
+    s.push_back(x);
+    ZuptDecision z;
+    const char c = gait[k];
+    z.stance = c == 'D';
+    z.gait_state = c == 'A' ? kPushOff : c == 'B' ? kSwing : c == 'C' ? kHeelStrike : kStance;
+    d.push_back(z);
+    T.push_back(c == 'D' ? 20.0 : 60.0 + k % 3);  // the foot never stops: T above γ = 10 everywhere
+  }
+  ZuptDetectorOptions o;
+  o.hmm_refine_factor = 2.0;
+  o.min_stance_s = 0.04;
+  refine_hmm_stances(d, s, T, o);
+  auto stance = [&](int a, int b) {
+    std::string r;
+    for (int k = a; k <= b; ++k) r += d[static_cast<std::size_t>(k)].stance ? '1' : '0';
+    return r;
+  };
+  EXPECT_EQ(stance(0, 9), "1111111111");  // long enough: its T < 40 core is the whole run
+  // The whole step (29-30, 10 ms): widened beyond its run to 40 ms = 5 samples, contiguous, inside the swings.
+  const std::string step = stance(14, 44);
+  EXPECT_EQ(std::count(step.begin(), step.end(), '1'), 5) << step;
+  EXPECT_NE(step.find("11111"), std::string::npos) << step;
+  EXPECT_TRUE(d[29].stance && d[30].stance);
+  EXPECT_EQ(stance(45, 53), "000010000");  // a D inside a heel strike: not widened (drop_short_runs removes it)
+  EXPECT_EQ(stance(54, 59), "111111");
+  EXPECT_EQ(stance(60, 66), "0001100");    // a second D of the same stance (no swing since 54-59): not widened
 }
 
 }  // namespace
