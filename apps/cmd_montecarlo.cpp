@@ -121,6 +121,7 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
   if (mo.gauss_markov_bias) c.bias.model = "gauss_markov";
   fusion::EngineOptions o = io::engine_options(c);
   if (mo.scale_states || mo.accel_scale_states) o.estimate_scale_factors = true;
+  if (mo.scale_states) o.estimate_gyro_scale_factors = true;  // both blocks (the tc default has the accelerometer one)
   if (mo.accel_scale_states) o.estimate_gyro_scale_factors = false;
   if (mo.bias_random_walk) o.bias_random_walk = true;
   o.repair_saturation = mo.saturation_repair;
