@@ -14,6 +14,7 @@
 
 namespace YAML {
 class Node;
+class Emitter;
 }
 
 namespace pednav::io {
@@ -207,6 +208,9 @@ void read_imu_spec(YamlMap& m, ins::ImuSpec& out);
 /// `preset` holds the default preset on entry ("" = none: a map then starts from ins::ImuSpec{}) and the name used on
 /// return; problems (unknown preset or key) go to m's problem list.
 void read_imu_spec_entry(YamlMap& m, const std::string& key, ins::ImuSpec& spec, std::string& preset);
+/// The inverse of read_imu_spec_entry: the preset's name when `spec` is exactly the preset, else the map
+/// {preset: NAME, <every read_imu_spec key>} (config.resolved.yaml reads back to the same spec).
+void emit_imu_spec(YAML::Emitter& e, const ins::ImuSpec& spec, const std::string& preset);
 /// A built-in IMU format preset (datasets/imu_formats/<name>.yaml), parsed.
 Expected<ImuFormat> imu_format_preset(const std::string& name);
 

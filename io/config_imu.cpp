@@ -102,29 +102,42 @@ void read_imu_format(YamlMap& m, ImuFormat& out) {
   m.number("rest_tolerance_mps2", out.rest_tolerance_mps2, false, 0.0, 100.0);
 }
 
-void read_imu_spec(YamlMap& m, ins::ImuSpec& s) {
-  // Each key: YAML unit -> SI factor.
+namespace {
+// The spec keys of a run configuration: YAML key, field, YAML unit -> SI factor.
+struct SpecKey {
+  const char* key;
+  double ins::ImuSpec::*field;
+  double factor;
+};
+const std::vector<SpecKey>& spec_keys() {
   const double dps = kDegToRad, dph = kDegToRad / 3600.0, mg = 1e-3 * kG0;
-  auto scaled = [&](const char* key, double& field, double factor) {
-    double v = field / factor;
-    m.number(key, v, false, 0.0, 1e12);
-    field = v * factor;
+  static const std::vector<SpecKey> keys{
+      {"gyro_arw_deg_per_sqrt_hr", &ins::ImuSpec::gyro_arw, kDegToRad / 60.0},
+      {"accel_vrw_mps_per_sqrt_hr", &ins::ImuSpec::accel_vrw, 1.0 / 60.0},
+      {"gyro_bias_instability_deg_per_hr", &ins::ImuSpec::gyro_bias_instability, dph},
+      {"gyro_bias_tau_s", &ins::ImuSpec::gyro_bias_tau_s, 1.0},
+      {"gyro_bias_rw_deg_per_hr_per_sqrt_hr", &ins::ImuSpec::gyro_bias_rw, dph / 60.0},
+      {"gyro_bias_initial_deg_per_s", &ins::ImuSpec::gyro_bias_initial, dps},
+      {"accel_bias_instability_mg", &ins::ImuSpec::accel_bias_instability, mg},
+      {"accel_bias_tau_s", &ins::ImuSpec::accel_bias_tau_s, 1.0},
+      {"accel_bias_rw_mps2_per_sqrt_s", &ins::ImuSpec::accel_bias_rw, 1.0},
+      {"accel_bias_initial_mg", &ins::ImuSpec::accel_bias_initial, mg},
+      {"gyro_scale_ppm", &ins::ImuSpec::gyro_scale_sigma, 1e-6},
+      {"accel_scale_ppm", &ins::ImuSpec::accel_scale_sigma, 1e-6},
+      {"scale_tau_s", &ins::ImuSpec::scale_tau_s, 1.0},
+      {"gyro_range_deg_per_s", &ins::ImuSpec::gyro_range, dps},
+      {"accel_range_g", &ins::ImuSpec::accel_range, kG0},
   };
-  scaled("gyro_arw_deg_per_sqrt_hr", s.gyro_arw, kDegToRad / 60.0);
-  scaled("accel_vrw_mps_per_sqrt_hr", s.accel_vrw, 1.0 / 60.0);
-  scaled("gyro_bias_instability_deg_per_hr", s.gyro_bias_instability, dph);
-  scaled("gyro_bias_tau_s", s.gyro_bias_tau_s, 1.0);
-  scaled("gyro_bias_rw_deg_per_hr_per_sqrt_hr", s.gyro_bias_rw, dph / 60.0);
-  scaled("gyro_bias_initial_deg_per_s", s.gyro_bias_initial, dps);
-  scaled("accel_bias_instability_mg", s.accel_bias_instability, mg);
-  scaled("accel_bias_tau_s", s.accel_bias_tau_s, 1.0);
-  scaled("accel_bias_rw_mps2_per_sqrt_s", s.accel_bias_rw, 1.0);
-  scaled("accel_bias_initial_mg", s.accel_bias_initial, mg);
-  scaled("gyro_scale_ppm", s.gyro_scale_sigma, 1e-6);
-  scaled("accel_scale_ppm", s.accel_scale_sigma, 1e-6);
-  scaled("scale_tau_s", s.scale_tau_s, 1.0);
-  scaled("gyro_range_deg_per_s", s.gyro_range, dps);
-  scaled("accel_range_g", s.accel_range, kG0);
+  return keys;
+}
+}  // namespace
+
+void read_imu_spec(YamlMap& m, ins::ImuSpec& s) {
+  for (const SpecKey& k : spec_keys()) {
+    double v = s.*k.field / k.factor;
+    m.number(k.key, v, false, 0.0, 1e12);
+    s.*k.field = v * k.factor;
+  }
   if (s.gyro_bias_instability > 0 && !(s.gyro_bias_tau_s > 0))
     m.problem("gyro_bias_tau_s", "must be > 0 when gyro_bias_instability_deg_per_hr is given");
   if (s.accel_bias_instability > 0 && !(s.accel_bias_tau_s > 0))
@@ -194,6 +207,22 @@ void read_imu_spec_entry(YamlMap& m, const std::string& key, ins::ImuSpec& spec,
     m.text(key, preset);
     start_from_preset(m, key);
   }
+}
+
+void emit_imu_spec(YAML::Emitter& e, const ins::ImuSpec& spec, const std::string& preset) {
+  if (!preset.empty()) {
+    auto p = ins::imu_spec_preset(preset);
+    bool same = p.has_value();
+    for (const SpecKey& k : spec_keys()) same = same && (*p).*k.field == spec.*k.field;
+    if (same) {
+      e << preset;
+      return;
+    }
+  }
+  e << YAML::BeginMap;
+  if (!preset.empty()) e << YAML::Key << "preset" << YAML::Value << preset;
+  for (const SpecKey& k : spec_keys()) e << YAML::Key << k.key << YAML::Value << spec.*k.field / k.factor;
+  e << YAML::EndMap;
 }
 
 }  // namespace pednav::io

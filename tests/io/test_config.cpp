@@ -1,6 +1,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "core/geodesy.hpp"
 #include "io/config.hpp"
 
 namespace pednav::io {
@@ -151,6 +152,25 @@ TEST(Config, ImuErrorModelDefaultsDependOnTheMode) {
   EXPECT_EQ(again->scale_factors.states, std::optional<bool>(true));
   EXPECT_FALSE(again->scale_factors.gyro);
   EXPECT_EQ(again->bias.model, "random_walk");
+}
+
+// config.resolved.yaml keeps an imu.spec map's overrides (it used to write the preset name only, losing them).
+TEST(Config, ResolvedConfigurationKeepsImuSpecOverrides) {
+  const std::string files = "rover_obs: r.obs\nnav: n.nav\n";
+  auto cfg = parse("mode: tc\n" + files +
+                   "imu: {file: i.csv, format: pyshoe, spec: {preset: crista, gyro_range_deg_per_s: 2000, "
+                   "accel_scale_ppm: 0}}\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  auto again = parse(to_yaml(*cfg));
+  ASSERT_TRUE(again) << again.error().message << "\n" << to_yaml(*cfg);
+  EXPECT_DOUBLE_EQ(again->imu.spec.gyro_range, 2000.0 * kDegToRad);
+  EXPECT_EQ(again->imu.spec.accel_scale_sigma, 0.0);
+  EXPECT_DOUBLE_EQ(again->imu.spec.gyro_arw, cfg->imu.spec.gyro_arw);
+  EXPECT_EQ(again->imu.spec_preset, "crista");
+  // A plain preset is written as its name.
+  auto plain = parse("mode: tc\n" + files + "imu: {file: i.csv, format: pyshoe, spec: crista}\n");
+  ASSERT_TRUE(plain) << plain.error().message;
+  EXPECT_THAT(to_yaml(*plain), HasSubstr("spec: crista"));
 }
 
 TEST(Config, MultipathAndScaleFactorStateKeys) {
