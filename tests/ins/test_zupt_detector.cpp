@@ -241,13 +241,9 @@ TEST(ZuptDetector, HmmRefineThresholdAdaptsToAFootThatNeverStops) {
   EXPECT_LE(a.rolling, 8 * g.stances);
 }
 
-// hmm_min_swing_s: a stance run right after a push-off is dropped, a stance broken by a flicker is not, and a
-// stance after a full swing is kept (100 Hz decisions built by hand: D = stance, A = push-off, B = swing).
-TEST(ZuptDetector, StanceRightAfterPushOffIsDropped) {
-  const char* gait = "DDDDDDDDDDAAAAAAAAAADDDDDDDDAAAAABBBBBBBBBBBBBBBBBBBBBBBBBBBBBBBCCDDDDD.DDDDDD";
-  // D 0-9, A 10-19, D 20-27, A 28-32, B 33-63, C 64-65, D 66-70, flicker 71, D 72-77
-  std::vector<ImuSample> s;
-  std::vector<ZuptDecision> d;
+// 100 Hz samples and decisions from a gait string (D = stance, A = push-off, B = swing, C = heel strike, other
+// characters: a non-stance flicker decoded as D).
+void gait_from_string(const char* gait, std::vector<ImuSample>& s, std::vector<ZuptDecision>& d) {
   for (int k = 0; gait[k] != '\0'; ++k) {
     ImuSample x;
     x.t = GpsTime::from_week_tow(0, 0.01 * k);
@@ -258,6 +254,16 @@ TEST(ZuptDetector, StanceRightAfterPushOffIsDropped) {
     z.gait_state = c == 'A' ? kPushOff : c == 'B' ? kSwing : c == 'C' ? kHeelStrike : kStance;
     d.push_back(z);
   }
+}
+
+// hmm_min_swing_s: a stance run right after a push-off is dropped, a stance broken by a flicker is not, and a
+// stance after a full swing is kept (100 Hz decisions built by hand: D = stance, A = push-off, B = swing).
+TEST(ZuptDetector, StanceRightAfterPushOffIsDropped) {
+  const char* gait = "DDDDDDDDDDAAAAAAAAAADDDDDDDDAAAAABBBBBBBBBBBBBBBBBBBBBBBBBBBBBBBCCDDDDD.DDDDDD";
+  // D 0-9, A 10-19, D 20-27, A 28-32, B 33-63, C 64-65, D 66-70, flicker 71, D 72-77
+  std::vector<ImuSample> s;
+  std::vector<ZuptDecision> d;
+  gait_from_string(gait, s, d);
   auto stance_at = [&](int k) { return d[static_cast<std::size_t>(k)].stance; };
   drop_stances_right_after_push_off(d, s, 0.3);
   EXPECT_TRUE(stance_at(5));    // the first stance is kept
@@ -283,18 +289,9 @@ TEST(ZuptDetector, ShortWholeStepIsWidenedOthersAreNot) {
   // D 54-59; C 60-62, D 63-64 (no swing since the stance at 54-59); A, B.
   std::vector<ImuSample> s;
   std::vector<ZuptDecision> d;
-  std::vector<double> T;
-  for (int k = 0; gait[k] != '\0'; ++k) {
-    ImuSample x;
-    x.t = GpsTime::from_week_tow(0, 0.01 * k);
-    s.push_back(x);
-    ZuptDecision z;
-    const char c = gait[k];
-    z.stance = c == 'D';
-    z.gait_state = c == 'A' ? kPushOff : c == 'B' ? kSwing : c == 'C' ? kHeelStrike : kStance;
-    d.push_back(z);
-    T.push_back(c == 'D' ? 20.0 : 60.0 + k % 3);  // the foot never stops: T above γ = 10 everywhere
-  }
+  gait_from_string(gait, s, d);
+  std::vector<double> T;  // the foot never stops: T above γ = 10 everywhere
+  for (int k = 0; gait[k] != '\0'; ++k) T.push_back(gait[k] == 'D' ? 20.0 : 60.0 + k % 3);
   ZuptDetectorOptions o;
   o.hmm_refine_factor = 2.0;
   o.min_stance_s = 0.04;
