@@ -641,7 +641,7 @@ class Runner {
       if (r.last < start) continue;
       ++sum.saturated_runs;
       if (r.reconstructed) ++sum.saturated_runs_reconstructed;
-      if (r.gyro) sum.saturation_max_added_deg = std::max(sum.saturation_max_added_deg, std::abs(r.added) * 180.0 / M_PI);
+      if (r.gyro) sum.saturation_max_added_deg = std::max(sum.saturation_max_added_deg, std::abs(r.added) * kRadToDeg);
     }
     for (const auto& s : sat_samples) sum.saturated_samples += s.index >= start ? 1 : 0;
     sum.saturation_notes = saturation_.notes;

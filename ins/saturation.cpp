@@ -100,23 +100,18 @@ SaturationRepair repair_saturation(const std::vector<ImuSample>& samples, const 
         for (int m = 1; ok && m <= nf; ++m) ok = usable(i - m, axis) && usable(j + m, axis);
         if (ok) {
           const GpsTime t0 = samples[i].t;
+          // The `count` nearest neighbours on each side of the run (time since its first sample, value).
+          auto neighbours = [&](int count, std::vector<double>& t, std::vector<double>& y) {
+            for (int m = -count; m <= count; ++m) {
+              if (m == 0) continue;
+              const ImuSample& x = samples[m < 0 ? i - static_cast<size_t>(-m) : j + static_cast<size_t>(m)];
+              t.push_back(x.t - t0);
+              y.push_back(value(x, gyro, axis));
+            }
+          };
           std::vector<double> t4, y4, t2, y2;
-          for (int m = nf; m >= 1; --m) {
-            t4.push_back(samples[i - m].t - t0);
-            y4.push_back(value(samples[i - m], gyro, axis));
-          }
-          for (int m = 1; m <= nf; ++m) {
-            t4.push_back(samples[j + m].t - t0);
-            y4.push_back(value(samples[j + m], gyro, axis));
-          }
-          for (int m = nf - 1; m >= 1; --m) {
-            t2.push_back(samples[i - m].t - t0);
-            y2.push_back(value(samples[i - m], gyro, axis));
-          }
-          for (int m = 1; m <= nf - 1; ++m) {
-            t2.push_back(samples[j + m].t - t0);
-            y2.push_back(value(samples[j + m], gyro, axis));
-          }
+          neighbours(nf, t4, y4);
+          neighbours(nf - 1, t2, y2);
           const double t_c = 0.5 * (t4.front() + t4.back()), h = std::max(0.5 * (t4.back() - t4.front()), 1e-9);
           const PolyFit p4(t4, y4, 4, t_c, h), p2(t2, y2, 2, t_c, h);
           double added4 = 0.0, added2 = 0.0;
