@@ -3,6 +3,7 @@
 #include "fusion/health.hpp"
 #include "fusion/kalman.hpp"
 #include "fusion/rts.hpp"
+#include "fusion/stride_velocity.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
@@ -81,6 +82,9 @@ struct Row {
   double residual = 0.0;
   ins::ErrorRowVector h;
   double sigma = 0.0;
+  /// ∂(predicted)/∂(antenna position) for code rows, ∂/∂(antenna velocity) for Doppler rows: projects the
+  /// non-rigid arm's offset / velocity noise common to all satellites into R.
+  Eigen::RowVector3d j_antenna = Eigen::RowVector3d::Zero();
 };
 
 // The IMU spec as the filter models it. With bias_random_walk the Gauss-Markov bias part (σ, τ) becomes a random
@@ -506,7 +510,16 @@ class Runner {
       filter_sigma_yaw_rad = kInsFilterSigmaYawRad;
     }
     f.init(nav0, imu0, filter_sigma_yaw_rad);
+    stride_.reset();
     EngineSummary& sum = result.summary;
+    if (o_.mode == Mode::kTightlyCoupled) {
+      // The outcomes every epoch can have exist from the start (0 until they happen): a first rejection later in
+      // the run then does not allocate a map node on the per-epoch path (tests/fusion/test_allocations.cpp).
+      for (auto* m : {&sum.code_used_rejected, &sum.doppler_used_rejected}) {
+        m->try_emplace("used", 0);
+        m->try_emplace("innovation_fault", 0);
+      }
+    }
     // Smoother (docs/fusion.md §12): one backward record per output epoch, carried forward from each output epoch
     // to the next by the filter (eqs. 12.14-12.20).
     const bool smooth = o_.smoother_enabled;
@@ -558,10 +571,12 @@ class Runner {
 
     auto on_increment = [&](const ins::ImuIncrement& inc) {
       if (failed || waiting) return;
+      const Vector3d p_before = f.x().nav.p_eb_e;
       f.predict(inc);
       ++sum.mechanization_steps;
       // ZUPT (+ ZARU) when the detector flags the sample at the interval end as stance.
       const bool stance = decisions_[std::min(sample_index, decisions_.size() - 1)].stance;
+      stride_.push(inc.t1.ns(), f.x().nav.p_eb_e - p_before, stance);  // mechanized displacement only (eq. 13.1)
       if (stance && o_.zupt_updates) {
         zupt_update(f, inc, prev_stance);
         ++sum.zupt_updates;
@@ -677,6 +692,7 @@ class Runner {
         implausible_streak_ = 0;
         prev_stance = false;
         last_used = last_rejected = 0;
+        stride_.reset();
         if (steps) steps.emplace(o_.step_velocity);
       }
       ++sum.imu_samples;
@@ -902,7 +918,11 @@ class Runner {
     const double lag_s = t_proc - re.time;  // the state is at t_proc; move the antenna back to the epoch
     const Vector3d p_imu = f.x().nav.p_eb_e - f.x().nav.v_eb_e * lag_s;
     const Vector3d p_a = p_imu + lever_e(p_imu);
-    const Vector3d v_a = f.x().nav.v_eb_e;
+    // Antenna (body) velocity: the foot's stride-average velocity (eq. 13.1) or, with the kFoot model or before a
+    // cycle of history exists, the foot's own velocity.
+    std::optional<Vector3d> v_stride;
+    if (o_.antenna_velocity_model == AntennaVelocityModel::kStrideAverage) v_stride = stride_.velocity_e();
+    const Vector3d v_a = v_stride ? *v_stride : f.x().nav.v_eb_e;
     const Geodetic llh = geodetic_from_ecef(p_a);
     std::vector<Row>& rows = rows_;
     rows.clear();
@@ -960,6 +980,7 @@ class Runner {
       rc.sigma = sigma_c;
       rc.h = ins::ErrorRowVector::Zero(n);
       rc.h.segment<3>(ins::kPos.offset) = code.J_p;
+      rc.j_antenna = code.J_p;
       rc.h(f.clock_offset(slot)) = code.J_clock;
       if (f.has_multipath()) {
         // Code multipath σ_mp(C/N0) u_s (docs/consistency.md eq. M.2); SD: rover and base in quadrature.
@@ -988,7 +1009,13 @@ class Runner {
         rd.sigma = sigma_d;
         rd.h = ins::ErrorRowVector::Zero(n);
         rd.h.segment<3>(ins::kPos.offset) = rate.J_p;
-        rd.h.segment<3>(ins::kVel.offset) = rate.J_v;
+        rd.j_antenna = rate.J_v;
+        if (v_stride) {
+          // δv̄ = −[v̄×] φ (eq. 13.2): the heading error rotates the INS stride; the velocity error is not in v̄.
+          rd.h.segment<3>(ins::kAtt.offset) = -(rate.J_v * skew(*v_stride));
+        } else {
+          rd.h.segment<3>(ins::kVel.offset) = rate.J_v;
+        }
         rd.h(f.drift_offset()) = rate.J_drift;
         rows.push_back(rd);
       }
@@ -1027,7 +1054,8 @@ class Runner {
                                                  o_.antenna_sigma_horizontal_m * o_.antenna_sigma_horizontal_m,
                                                  o_.antenna_sigma_vertical_m * o_.antenna_sigma_vertical_m)
                                             .asDiagonal() * Ren.transpose();
-    const double svh = o_.antenna_velocity_sigma_horizontal_mps, svv = o_.antenna_velocity_sigma_vertical_mps;
+    const double svh = v_stride ? o_.antenna_stride_velocity_sigma_horizontal_mps : o_.antenna_velocity_sigma_horizontal_mps;
+    const double svv = v_stride ? o_.antenna_stride_velocity_sigma_vertical_mps : o_.antenna_velocity_sigma_vertical_mps;
     const Eigen::Matrix3d C_vel = Ren * Vector3d(svh * svh, svh * svh, svv * svv).asDiagonal() * Ren.transpose();
     // w-test fault rejection, worst first (Baarda): w_i = (S^-1 nu)_i / sqrt((S^-1)_ii) against chi2(1, p).
     const double threshold = w_test_threshold_;
@@ -1051,11 +1079,7 @@ class Runner {
         for (int j = 0; j < m; ++j) {
           const Row& a = rows[active[i]];
           const Row& b = rows[active[j]];
-          const Eigen::RowVector3d ja = a.doppler ? Eigen::RowVector3d(a.h.segment<3>(ins::kVel.offset))
-                                                  : Eigen::RowVector3d(a.h.segment<3>(ins::kPos.offset));
-          const Eigen::RowVector3d jb = b.doppler ? Eigen::RowVector3d(b.h.segment<3>(ins::kVel.offset))
-                                                  : Eigen::RowVector3d(b.h.segment<3>(ins::kPos.offset));
-          if (a.doppler == b.doppler) R(i, j) += ja * (a.doppler ? C_vel : C_pos) * jb.transpose();
+          if (a.doppler == b.doppler) R(i, j) += a.j_antenna * (a.doppler ? C_vel : C_pos) * b.j_antenna.transpose();
         }
       }
     };
@@ -1143,6 +1167,7 @@ class Runner {
   const std::vector<ins::ZuptDecision>& decisions_;
   const double w_test_threshold_;  // chi2(1) quantile at o_.fault_probability
   ins::SaturationRepair saturation_;  // clipped samples repaired once per run (docs/ins.md §9)
+  StrideVelocity stride_;             // stride-average foot velocity: the antenna velocity (docs/fusion.md §13)
   std::vector<gnss::BaseMatch> matches_;
   bool sd_ = false;
   FrameYaw frame_;

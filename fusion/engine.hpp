@@ -26,6 +26,9 @@ namespace pednav::fusion {
 enum class Mode { kTightlyCoupled, kInsOnly };
 enum class ZuptForm { kDynamic /* D, seed 001 eq. 8 */, kFull /* F, seed 001 eq. 9 */ };
 
+/// Antenna velocity model of the Doppler rows (EngineOptions::antenna_velocity_model).
+enum class AntennaVelocityModel { kFoot, kStrideAverage };
+
 struct EngineOptions {
   Mode mode = Mode::kTightlyCoupled;
   double mechanization_rate_hz = 20.0;
@@ -62,6 +65,13 @@ struct EngineOptions {
   double antenna_sigma_vertical_m = 0.2;
   double antenna_velocity_sigma_horizontal_mps = 1.0;  ///< foot vs body velocity at the GNSS epoch [m/s]
   double antenna_velocity_sigma_vertical_mps = 0.3;
+  /// What the Doppler rows predict as the antenna (body) velocity (docs/fusion.md §13). kStrideAverage: the foot's
+  /// mean velocity over the last gait cycle (fusion/stride_velocity.hpp, eq. 13.1), Jacobian on the attitude error
+  /// (eq. 13.2), noise antenna_stride_velocity_sigma_*; kFoot: the foot's instantaneous velocity, Jacobian on the
+  /// velocity error, noise antenna_velocity_sigma_* (biased by gait phase: along-track lag).
+  AntennaVelocityModel antenna_velocity_model = AntennaVelocityModel::kStrideAverage;
+  double antenna_stride_velocity_sigma_horizontal_mps = 0.3;  ///< body vs stride-average foot velocity [m/s]
+  double antenna_stride_velocity_sigma_vertical_mps = 0.3;
   /// Estimate gyro and accelerometer scale-factor errors (ins layout blocks scale_gyro, scale_acc with the spec's
   /// *_scale_sigma and scale_tau_s). Off: scale-factor errors are not modelled (docs/consistency.md §3).
   bool estimate_scale_factors = false;

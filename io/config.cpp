@@ -124,6 +124,16 @@ std::string to_yaml(const RunConfig& c) {
     }
     e << YAML::EndMap;
   }
+  e << YAML::Key << "antenna" << YAML::Value << YAML::BeginMap << YAML::Key << "lever_arm_ned_m" << YAML::Value
+    << YAML::Flow << YAML::BeginSeq << c.antenna.lever_arm_ned_m.x() << c.antenna.lever_arm_ned_m.y()
+    << c.antenna.lever_arm_ned_m.z() << YAML::EndSeq << YAML::Key << "sigma_horizontal_m" << YAML::Value
+    << c.antenna.sigma_horizontal_m << YAML::Key << "sigma_vertical_m" << YAML::Value << c.antenna.sigma_vertical_m
+    << YAML::Key << "velocity_model" << YAML::Value << c.antenna.velocity_model << YAML::Key
+    << "velocity_sigma_horizontal_mps" << YAML::Value << c.antenna.velocity_sigma_horizontal_mps << YAML::Key
+    << "velocity_sigma_vertical_mps" << YAML::Value << c.antenna.velocity_sigma_vertical_mps << YAML::Key
+    << "stride_velocity_sigma_horizontal_mps" << YAML::Value << c.antenna.stride_velocity_sigma_horizontal_mps
+    << YAML::Key << "stride_velocity_sigma_vertical_mps" << YAML::Value
+    << c.antenna.stride_velocity_sigma_vertical_mps << YAML::EndMap;
   e << YAML::Key << "mechanization_rate_hz" << YAML::Value << c.mechanization_rate_hz;
   e << YAML::Key << "zupt" << YAML::Value << YAML::BeginMap << YAML::Key << "detector" << YAML::Value
     << c.zupt.detector << YAML::Key << "form" << YAML::Value << c.zupt.form << YAML::EndMap;

@@ -111,6 +111,9 @@ struct AntennaConfig {
   double sigma_vertical_m = 0.2;
   double velocity_sigma_horizontal_mps = 1.0;
   double velocity_sigma_vertical_mps = 0.3;
+  std::string velocity_model = "stride_average";  ///< stride_average | foot (docs/fusion.md §13)
+  double stride_velocity_sigma_horizontal_mps = 0.3;
+  double stride_velocity_sigma_vertical_mps = 0.3;
 };
 
 /// `clock:` section: differential receiver clock model.

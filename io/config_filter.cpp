@@ -71,6 +71,9 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
     a.number("sigma_vertical_m", c.sigma_vertical_m, false, 0.0, 100.0);
     a.number("velocity_sigma_horizontal_mps", c.velocity_sigma_horizontal_mps, false, 0.0, 100.0);
     a.number("velocity_sigma_vertical_mps", c.velocity_sigma_vertical_mps, false, 0.0, 100.0);
+    a.choice("velocity_model", c.velocity_model, {"stride_average", "foot"});
+    a.number("stride_velocity_sigma_horizontal_mps", c.stride_velocity_sigma_horizontal_mps, false, 1e-3, 100.0);
+    a.number("stride_velocity_sigma_vertical_mps", c.stride_velocity_sigma_vertical_mps, false, 1e-3, 100.0);
   }
   {
     YamlMap k = top.map("clock");

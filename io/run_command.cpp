@@ -124,6 +124,10 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.antenna_sigma_vertical_m = c.antenna.sigma_vertical_m;
   o.antenna_velocity_sigma_horizontal_mps = c.antenna.velocity_sigma_horizontal_mps;
   o.antenna_velocity_sigma_vertical_mps = c.antenna.velocity_sigma_vertical_mps;
+  o.antenna_velocity_model = c.antenna.velocity_model == "foot" ? fusion::AntennaVelocityModel::kFoot
+                                                                : fusion::AntennaVelocityModel::kStrideAverage;
+  o.antenna_stride_velocity_sigma_horizontal_mps = c.antenna.stride_velocity_sigma_horizontal_mps;
+  o.antenna_stride_velocity_sigma_vertical_mps = c.antenna.stride_velocity_sigma_vertical_mps;
   o.clock_psd_m2_per_s = c.clock.psd_m2_per_s;
   o.drift_psd_m2_per_s3 = c.clock.drift_psd_m2_per_s3;
   o.clock_jump_threshold_m = c.clock.jump_threshold_m;
