@@ -72,13 +72,13 @@ Expected<RunConfig> load_run_config(const std::string& path) {
   return parse_run_config(src->text, path, src->base_dir);
 }
 
-// docs/consistency.md §3.3: in mode tc the GNSS observes the accelerometer scale factors and the turn-on biases, so
-// the filter gets the accelerometer scale-factor states and the random-walk bias model; in mode ins it does not.
+// docs/consistency.md §3.3-3.4: in mode tc the GNSS observes the scale factors and the turn-on biases, so the filter
+// gets the scale-factor states (gyro and accelerometer) and the random-walk bias model; in mode ins it does not.
 ImuErrorModelChoice imu_error_model_choice(const RunConfig& c) {
   const bool tc = c.mode == "tc";
   ImuErrorModelChoice m;
   m.scale_states = c.scale_factors.states.value_or(tc);
-  m.gyro_scale_states = m.scale_states && (c.scale_factors.states ? c.scale_factors.gyro : false);
+  m.gyro_scale_states = m.scale_states && c.scale_factors.gyro;
   m.bias_random_walk = c.bias.model == "auto" ? tc : c.bias.model == "random_walk";
   return m;
 }
@@ -148,7 +148,7 @@ std::string to_yaml(const RunConfig& c) {
     << c.multipath.reset_gap_s << YAML::EndMap;
   const ImuErrorModelChoice m = imu_error_model_choice(c);  // written resolved: what this run's filter used
   e << YAML::Key << "scale_factors" << YAML::Value << YAML::BeginMap << YAML::Key << "states" << YAML::Value
-    << m.scale_states << YAML::Key << "gyro" << YAML::Value << (m.scale_states ? m.gyro_scale_states : c.scale_factors.gyro)
+    << m.scale_states << YAML::Key << "gyro" << YAML::Value << c.scale_factors.gyro
     << YAML::EndMap;
   e << YAML::Key << "bias" << YAML::Value << YAML::BeginMap << YAML::Key << "model" << YAML::Value
     << (m.bias_random_walk ? "random_walk" : "gauss_markov") << YAML::EndMap;

@@ -135,10 +135,10 @@ struct MultipathConfig {
 
 /// `scale_factors:` section: IMU scale-factor states (the spec's *_scale_sigma, docs/consistency.md §3).
 struct ScaleFactorConfig {
-  /// unset (the default, or `auto`): accelerometer scale factors in mode tc, none in mode ins — without GNSS nothing
-  /// separates a scale factor from the attitude and velocity errors the ZUPTs see (docs/consistency.md §3.3).
+  /// unset (the default, or `auto`): scale factors in mode tc, none in mode ins — without GNSS nothing separates a
+  /// scale factor from the attitude and velocity errors the ZUPTs see (docs/consistency.md §3.3, §3.4).
   std::optional<bool> states;
-  bool gyro = true;     ///< with `states: true`: also the gyro block (false: accelerometer scale factors only, §3.2)
+  bool gyro = true;     ///< with scale-factor states: also the gyro block (false: accelerometer scale factors only)
 };
 
 /// `bias:` section: how the filter models the IMU biases (docs/consistency.md §3.2).

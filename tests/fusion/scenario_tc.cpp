@@ -149,16 +149,17 @@ Vertical vertical_of(const fusion::EngineResult& r, const std::function<const in
   return v;
 }
 
-// The tc defaults estimate the accelerometer scale factors and model the turn-on bias as a random constant
-// (docs/consistency.md §3.2-3.3). With the earlier defaults (no scale states, Gauss-Markov bias) the same run is
-// +1.86 m up with 15 % of the epochs inside 3σ_U (+1.89 m before the saturation repair).
+// The tc defaults estimate the scale factors and model the turn-on bias as a random constant (docs/consistency.md
+// §3.2-3.4). With the earlier defaults (no scale states, Gauss-Markov bias) the same run is +1.8 m up with 15 % of
+// the epochs inside 3σ_U (+1.89 m before the saturation repair). Of the remaining mean, +0.35 m is the geometry: the
+// default lever arm (1.2 m) is shorter than the simulated walker's foot-to-antenna height (1.55 m).
 TEST_F(ForestWalkTc, VerticalSigmaIsHonest) {
   const Vertical now = vertical_of(g_run->result, truth_at);
   auto file = io::load_scenario("datasets/forest_walk.yaml");
   ASSERT_TRUE(file.has_value()) << file.error().message;
   fusion::EngineOptions o = test::tc_default_options(*file, g_run->sim);
   EXPECT_TRUE(o.estimate_scale_factors);
-  EXPECT_FALSE(o.estimate_gyro_scale_factors);
+  EXPECT_TRUE(o.estimate_gyro_scale_factors);
   EXPECT_TRUE(o.bias_random_walk);
   o.estimate_scale_factors = false;
   o.bias_random_walk = false;
@@ -166,12 +167,12 @@ TEST_F(ForestWalkTc, VerticalSigmaIsHonest) {
   auto before = fusion::run_forward(test::engine_inputs(g_run->sim), o);
   ASSERT_TRUE(before.has_value()) << before.error().message;
   const Vertical old = vertical_of(*before, truth_at);
-  std::printf("[ forest ] vertical: mean up error %+.2f m, %.1f %% inside 3 sigma_U (without the accelerometer scale "
-              "states and the random-walk bias: %+.2f m, %.1f %%)\n",
+  std::printf("[ forest ] vertical: mean up error %+.2f m, %.1f %% inside 3 sigma_U (without the scale-factor states "
+              "and the random-walk bias: %+.2f m, %.1f %%)\n",
               now.mean_up_m, 100.0 * now.inside_3sigma, old.mean_up_m, 100.0 * old.inside_3sigma);
-  EXPECT_LT(std::abs(now.mean_up_m), 0.6);   // measured +0.29 m
+  EXPECT_LT(std::abs(now.mean_up_m), 0.8);   // measured +0.55 m (+0.29 m with the accelerometer block only)
   EXPECT_GE(now.inside_3sigma, 0.97);        // measured 100 %
-  EXPECT_GT(old.mean_up_m, 1.2);             // measured +1.86 m
+  EXPECT_GT(old.mean_up_m, 1.2);             // measured +1.81 m
   EXPECT_LT(old.inside_3sigma, 0.5);         // measured 15 %
 }
 

@@ -129,8 +129,13 @@ TEST(Config, ImuErrorModelDefaultsDependOnTheMode) {
   EXPECT_EQ(tc->bias.model, "auto");
   ImuErrorModelChoice m = imu_error_model_choice(*tc);
   EXPECT_TRUE(m.scale_states);
-  EXPECT_FALSE(m.gyro_scale_states);
+  EXPECT_TRUE(m.gyro_scale_states);  // both blocks since session 7 (docs/consistency.md §3.4)
   EXPECT_TRUE(m.bias_random_walk);
+  auto tc_acc = parse("mode: tc\n" + files + "scale_factors: {gyro: false}\n");
+  ASSERT_TRUE(tc_acc) << tc_acc.error().message;
+  m = imu_error_model_choice(*tc_acc);
+  EXPECT_TRUE(m.scale_states);
+  EXPECT_FALSE(m.gyro_scale_states);
   auto ins = parse("mode: ins\n" + files);
   ASSERT_TRUE(ins) << ins.error().message;
   m = imu_error_model_choice(*ins);
@@ -150,7 +155,7 @@ TEST(Config, ImuErrorModelDefaultsDependOnTheMode) {
   auto again = parse(to_yaml(*tc));
   ASSERT_TRUE(again) << again.error().message;
   EXPECT_EQ(again->scale_factors.states, std::optional<bool>(true));
-  EXPECT_FALSE(again->scale_factors.gyro);
+  EXPECT_TRUE(again->scale_factors.gyro);
   EXPECT_EQ(again->bias.model, "random_walk");
 }
 
