@@ -53,6 +53,7 @@ struct McOptions {
   bool no_scale_states = false;    ///< no scale-factor states (the mode-ins default; tc has accelerometer ones)
   bool gauss_markov_bias = false;  ///< Gauss-Markov bias model (the mode-ins default; tc uses the random walk)
   bool saturation_repair = true;   ///< reconstruct clipped IMU runs (`saturation: {repair: false}` to switch off)
+  bool foot_antenna_velocity = false;  ///< Doppler rows with the foot's own velocity (`antenna: {velocity_model: foot}`)
 };
 
 // One finished run (what runs.csv shows), with its per-epoch errors.
@@ -125,6 +126,7 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
   if (mo.accel_scale_states) o.estimate_gyro_scale_factors = false;
   if (mo.bias_random_walk) o.bias_random_walk = true;
   o.repair_saturation = mo.saturation_repair;
+  if (mo.foot_antenna_velocity) o.antenna_velocity_model = fusion::AntennaVelocityModel::kFoot;
   if (mo.multipath_states) {
     // The filter's multipath model = the simulator's (docs/consistency.md §3).
     o.multipath_sigma_m = sc.gnss.multipath_sigma_m;
@@ -435,6 +437,9 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
       ->excludes("--bias-random-walk");
   cmd->add_flag("!--no-saturation-repair", mo->saturation_repair,
                 "Integrate clipped IMU samples as they are (`saturation: {repair: false}`)");
+  cmd->add_flag("--foot-antenna-velocity", mo->foot_antenna_velocity,
+                "Doppler rows predict the antenna velocity as the foot's own (`antenna: {velocity_model: foot}`; "
+                "default: the stride-average foot velocity)");
   cmd->add_flag("--step-velocity", mo->step_velocity, "Seed 000 step-averaged velocity aiding");
   cmd->add_option("--leg-length-m", mo->leg_length_m, "Inverted-pendulum length l of the step-length model [m]")
       ->check(CLI::Range(0.05, 3.0));

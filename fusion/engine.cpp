@@ -1012,7 +1012,7 @@ class Runner {
         rd.j_antenna = rate.J_v;
         if (v_stride) {
           // δv̄ = −[v̄×] φ (eq. 13.2): the heading error rotates the INS stride; the velocity error is not in v̄.
-          rd.h.segment<3>(ins::kAtt.offset) = -(rate.J_v * skew(*v_stride));
+          rd.h.segment<3>(ins::kAtt.offset) = rate.J_v * stride_velocity_attitude_jacobian(*v_stride);
         } else {
           rd.h.segment<3>(ins::kVel.offset) = rate.J_v;
         }

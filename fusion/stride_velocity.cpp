@@ -4,6 +4,12 @@
 
 namespace pednav::fusion {
 
+Eigen::Matrix3d stride_velocity_attitude_jacobian(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, v.z(), -v.y(), -v.z(), 0.0, v.x(), v.y(), -v.x(), 0.0;  // −[v×]
+  return m;
+}
+
 void StrideVelocity::reset() {
   head_ = -1;
   size_ = 0;

@@ -26,6 +26,9 @@ struct StrideVelocityOptions {
   double default_cycle_s = 1.2;  ///< window before the first complete cycle [s]
 };
 
+/// ∂v̄_true/∂φ of eq. 13.2 at the estimate v̄ (ECEF): −[v̄×] (v̄_true = exp([φ×]) v̄ to first order).
+Eigen::Matrix3d stride_velocity_attitude_jacobian(const Eigen::Vector3d& v_bar_e);
+
 class StrideVelocity {
  public:
   explicit StrideVelocity(StrideVelocityOptions o = {}) : o_(o) {}
