@@ -70,8 +70,12 @@ std::string format_run_config(const sim::Simulation& s, const ScenarioFile& f) {
   const sim::Scenario& sc = s.scenario;
   std::string y = fmt::format("# Written by pednav simulate from {} (seed {}). Paths are relative to this file.\n",
                               f.source_file, sc.seed);
-  y += "# mode gnss until `pednav run` exists; set mode: tc for the tightly coupled filter.\n";
-  y += (s.has_gnss || f.real_gnss) ? "mode: gnss\n" : "mode: ins\n";
+  if (s.has_gnss || f.real_gnss) {
+    y += "# mode gnss: `pednav run` solves the GNSS epochs by least squares; `pednav run --mode tc` (or mode: tc) runs\n"
+         "# the tightly coupled filter.\nmode: gnss\n";
+  } else {
+    y += "mode: ins\n";
+  }
   if (f.real_gnss) {
     const RealGnssFiles& r = *f.real_gnss;
     const auto abs = [](const std::string& p) { return std::filesystem::absolute(p).lexically_normal().string(); };
