@@ -178,6 +178,33 @@ TEST(Config, ResolvedConfigurationKeepsImuSpecOverrides) {
   EXPECT_THAT(to_yaml(*plain), HasSubstr("spec: crista"));
 }
 
+// The antenna section: the Doppler rows' velocity model (docs/fusion.md §13), its bad value, and config.resolved.yaml
+// (which did not write the section before session 7) reading back to the same values.
+TEST(Config, AntennaVelocityModelKeysAndResolvedRoundTrip) {
+  const std::string files = "mode: gnss\nrover_obs: r.obs\nnav: n.nav\n";
+  auto def = parse(files);
+  ASSERT_TRUE(def) << def.error().message;
+  EXPECT_EQ(def->antenna.velocity_model, "stride_average");
+  auto cfg = parse(files + "antenna:\n  lever_arm_ned_m: [0.1, -0.2, -1.5]\n  velocity_model: foot\n"
+                           "  stride_velocity_sigma_horizontal_mps: 0.5\n  stride_velocity_sigma_vertical_mps: 0.2\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->antenna.velocity_model, "foot");
+  auto again = parse(to_yaml(*cfg));
+  ASSERT_TRUE(again) << again.error().message << "\n" << to_yaml(*cfg);
+  EXPECT_EQ(again->antenna.velocity_model, "foot");
+  EXPECT_DOUBLE_EQ(again->antenna.stride_velocity_sigma_horizontal_mps, 0.5);
+  EXPECT_DOUBLE_EQ(again->antenna.stride_velocity_sigma_vertical_mps, 0.2);
+  EXPECT_DOUBLE_EQ(again->antenna.lever_arm_ned_m.x(), 0.1);
+  EXPECT_DOUBLE_EQ(again->antenna.lever_arm_ned_m.z(), -1.5);
+  auto bad = parse(files + "antenna: {velocity_model: body}\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message,
+              HasSubstr("antenna.velocity_model: expected one of {stride_average, foot}, got 'body'"));
+  auto zero = parse(files + "antenna: {stride_velocity_sigma_horizontal_mps: 0}\n");
+  ASSERT_FALSE(zero);
+  EXPECT_THAT(zero.error().message, HasSubstr("antenna.stride_velocity_sigma_horizontal_mps"));
+}
+
 TEST(Config, MultipathAndScaleFactorStateKeys) {
   auto cfg = parse(
       "mode: gnss\nrover_obs: r.obs\nnav: n.nav\nmultipath:\n  states: true\n  sigma_m: 0.5\n  tau_s: 30\n"
