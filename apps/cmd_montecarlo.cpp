@@ -122,7 +122,7 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
   if (mo.gauss_markov_bias) c.bias.model = "gauss_markov";
   fusion::EngineOptions o = io::engine_options(c);
   if (mo.scale_states || mo.accel_scale_states) o.estimate_scale_factors = true;
-  if (mo.scale_states) o.estimate_gyro_scale_factors = true;  // both blocks (the tc default has the accelerometer one)
+  if (mo.scale_states) o.estimate_gyro_scale_factors = true;  // both blocks (the tc default since session 7)
   if (mo.accel_scale_states) o.estimate_gyro_scale_factors = false;
   if (mo.bias_random_walk) o.bias_random_walk = true;
   o.repair_saturation = mo.saturation_repair;
@@ -429,7 +429,7 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
   cmd->add_flag("--bias-random-walk", mo->bias_random_walk,
                 "Filter bias model: turn-on bias constant + random walk (`bias: {model: random_walk}`; tc default)");
   cmd->add_flag("--no-scale-states", mo->no_scale_states,
-                "No scale-factor states (`scale_factors: {states: false}`; mode tc has accelerometer ones by default)")
+                "No scale-factor states (`scale_factors: {states: false}`; mode tc has both blocks by default)")
       ->excludes("--scale-states")
       ->excludes("--accel-scale-states");
   cmd->add_flag("--gauss-markov-bias", mo->gauss_markov_bias,
