@@ -54,6 +54,7 @@ struct ObsReadStats {
   bool truncated = false;      ///< the last epoch record was incomplete (or the file ends inside a line)
   bool last_epoch_dropped = false;  ///< the file ended inside the last epoch's data: that epoch was dropped
   int records_out_of_range = 0;///< satellite records dated before 1980-01-06 or after 2106 (garbage dates): dropped
+  int duplicate_records = 0;   ///< a satellite's second record at an epoch time already read: dropped (the first kept)
 };
 
 /// An observation file as pednav sees it.

@@ -211,6 +211,28 @@ Expected<ObsData> read_rinex_obs(const std::string& path, const SystemSelection&
     out.epochs.pop_back();  // its last satellite line was cut: the numbers in it are not the receiver's
     out.stats.last_epoch_dropped = true;
   }
+  // RTKLIB's sortobs orders records whose times differ by less than its DTTOL as one time (then by satellite), so
+  // two epoch records a few ms apart come out interleaved: regroup by exact time, strictly increasing, one record
+  // per satellite (found by fuzz_rinex).
+  std::stable_sort(out.epochs.begin(), out.epochs.end(),
+                   [](const ObsEpoch& a, const ObsEpoch& b) { return a.time < b.time; });
+  std::vector<ObsEpoch> merged;
+  merged.reserve(out.epochs.size());
+  for (ObsEpoch& e : out.epochs) {
+    if (merged.empty() || std::abs(e.time - merged.back().time) > 1e-6) {
+      merged.push_back(std::move(e));
+      continue;
+    }
+    for (SatObs& s : e.sats) {
+      auto& into = merged.back().sats;
+      if (std::any_of(into.begin(), into.end(), [&](const SatObs& o) { return o.sat == s.sat; })) {
+        ++out.stats.duplicate_records;
+      } else {
+        into.push_back(s);
+      }
+    }
+  }
+  out.epochs = std::move(merged);
   if (out.epochs.empty()) {
     return make_error(path + (out.stats.truncated ? ": truncated: no complete observation epoch" : ": no usable observation epoch"));
   }

@@ -93,5 +93,31 @@ TEST(RobustRinexFuzzFinding, OutOfRangeSnrFieldIsNotAMemoryError) {
   EXPECT_DOUBLE_EQ(r->epochs[0].sats[0].pseudorange_m, 20123456.789);
 }
 
+TEST(RobustRinexFuzzFinding, EpochRecordsAFewMillisecondsApartComeOutSortedWithOneRecordPerSatellite) {
+  // RTKLIB's sortobs treats times closer than its DTTOL as one time and then orders by satellite, so these records
+  // came back interleaved (0.008, 0.000, 0.008, …) and the reader returned epochs out of order.
+  const std::string header = kObs.substr(0, kObs.find("> 2024"));
+  const std::string text = header +
+                           "> 2024 01 01 00 00  0.0080000  0  2\n"
+                           "G01  20123456.789   105789456.123 7     -1234.567          45.000  \n"
+                           "G07  20124456.789   105789457.123 7     -1233.567          44.000  \n"
+                           "> 2024 01 01 00 00  0.0000000  0  2\n"
+                           "G01  20123457.789   105789456.123 7     -1234.567          45.000  \n"
+                           "G07  20124457.789   105789457.123 7     -1233.567          44.000  \n"
+                           "> 2024 01 01 00 00  0.0080001  0  1\n"
+                           "G01  20123458.789   105789456.123 7     -1234.567          45.000  \n";
+  auto r = read_rinex_obs(write("interleaved.obs", text), SystemSelection{});
+  ASSERT_TRUE(r) << r.error().message;
+  ASSERT_EQ(r->epochs.size(), 2u);
+  EXPECT_TRUE(r->epochs[0].time < r->epochs[1].time);
+  EXPECT_NEAR(r->epochs[1].time - r->epochs[0].time, 0.008, 1e-6);
+  for (const auto& e : r->epochs) {
+    ASSERT_EQ(e.sats.size(), 2u);
+    EXPECT_FALSE(e.sats[0].sat == e.sats[1].sat);
+  }
+  EXPECT_DOUBLE_EQ(r->epochs[0].sats[0].pseudorange_m, 20123457.789);  // the 0.000 record
+  EXPECT_EQ(r->stats.duplicate_records, 1);                              // G01 at 0.0080001: the first kept
+}
+
 }  // namespace
 }  // namespace pednav::gnss
