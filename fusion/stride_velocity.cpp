@@ -2,13 +2,11 @@
 
 #include <cmath>
 
+#include "core/rotation.hpp"
+
 namespace pednav::fusion {
 
-Eigen::Matrix3d stride_velocity_attitude_jacobian(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, v.z(), -v.y(), -v.z(), 0.0, v.x(), v.y(), -v.x(), 0.0;  // −[v×]
-  return m;
-}
+Eigen::Matrix3d stride_velocity_attitude_jacobian(const Eigen::Vector3d& v) { return -skew(v); }
 
 void StrideVelocity::reset() {
   head_ = -1;
