@@ -149,7 +149,9 @@ double measurement_sigma(const WeightModel& m, double cn0_dbhz, double elevation
   const double cn0 = std::isnan(cn0_dbhz) ? m.cn0_ref_dbhz : cn0_dbhz;
   const double cn0_factor = std::pow(10.0, std::max(0.0, m.cn0_ref_dbhz - cn0) / 20.0);
   const double el = std::max(elevation_rad, m.min_elevation_for_weight_rad);
-  return sigma0 * cn0_factor / std::sin(el);
+  const double sin_el = std::sin(el);
+  if (m.elevation_weight == 1.0) return sigma0 * cn0_factor / sin_el;
+  return sigma0 * cn0_factor * std::sqrt(1.0 + m.elevation_weight * (1.0 / (sin_el * sin_el) - 1.0));
 }
 
 }  // namespace pednav::gnss

@@ -39,6 +39,9 @@ struct GnssConfig {
   double cn0_ref_dbhz = 45.0;            ///< C/N0 above which the noise no longer decreases [dB-Hz]
   double glonass_code_factor = 3.0;      ///< GLONASS code sigma / GPS code sigma (docs/gnss.md)
   double code_smoothing_s = 10.0;        ///< pednav gnss: Doppler smoothing window of the code [s], 0 = off (docs/gnss.md "Doppler smoothing of the code")
+  /// k of the weight model's elevation factor sqrt(1 + k (1/sin^2 el - 1)) (docs/gnss.md eq. W1), for the epoch
+  /// least squares and the filter's rows alike; 1 = sigma_zenith * c / sin(el).
+  double elevation_weight = 1.0;
 };
 
 /// `imu:` section.

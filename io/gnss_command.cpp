@@ -183,6 +183,7 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
   opt.weights.doppler_sigma_zenith_mps = g.doppler_sigma_zenith_mps;
   opt.weights.cn0_ref_dbhz = g.cn0_ref_dbhz;
   opt.weights.glonass_code_factor = g.glonass_code_factor;
+  opt.weights.elevation_weight = g.elevation_weight;
 
   std::vector<SolutionRow> rows;
   rows.reserve(rover->epochs.size());

@@ -1,6 +1,8 @@
 // SD/UD pseudorange and range-rate Jacobians against central differences; weighting; chi-square quantiles.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "gnss/least_squares.hpp"
 #include "gnss/measurement.hpp"
 #include "tests/support/numdiff.hpp"
@@ -92,6 +94,24 @@ TEST(Measurement, WeightsFollowCn0AndElevation) {
   EXPECT_NEAR(open, m.code_sigma_zenith_m, 1e-12);
   EXPECT_NEAR(measurement_sigma(m, 25.0, kPi / 2, false), 10.0 * open, 1e-9);  // 20 dB weaker -> 10x sigma
   EXPECT_NEAR(measurement_sigma(m, 45.0, 30.0 * kDegToRad, false), 2.0 * open, 1e-9);
+}
+
+// Eq. W1 (docs/gnss.md): sigma^2 = sigma0^2 c^2 (1 + k (1/sin^2 el - 1)); k = 1 is sigma0 c / sin el, k = 0 drops the
+// elevation; zenith and the C/N0 factor do not depend on k.
+TEST(Measurement, ElevationWeightScalesOnlyTheElevationPart) {
+  WeightModel m;
+  const double el = 30.0 * kDegToRad;  // 1/sin^2 - 1 = 3
+  for (const double k : {0.0, 0.3, 1.0}) {
+    m.elevation_weight = k;
+    EXPECT_NEAR(measurement_sigma(m, 45.0, kPi / 2, false), m.code_sigma_zenith_m, 1e-12) << k;
+    EXPECT_NEAR(measurement_sigma(m, 45.0, el, false), m.code_sigma_zenith_m * std::sqrt(1.0 + 3.0 * k), 1e-12) << k;
+    EXPECT_NEAR(measurement_sigma(m, 25.0, el, true), 10.0 * m.doppler_sigma_zenith_mps * std::sqrt(1.0 + 3.0 * k), 1e-12)
+        << k;
+  }
+  m.elevation_weight = 0.999999;  // continuous into the k = 1 branch
+  const double near_one = measurement_sigma(m, 40.0, 12.0 * kDegToRad, false);
+  m.elevation_weight = 1.0;
+  EXPECT_NEAR(near_one, measurement_sigma(m, 40.0, 12.0 * kDegToRad, false), 1e-5);
 }
 
 TEST(Measurement, ChiSquareQuantiles) {

@@ -3,6 +3,7 @@
 
 #include "core/geodesy.hpp"
 #include "io/config.hpp"
+#include "io/run_command.hpp"
 
 namespace pednav::io {
 namespace {
@@ -180,6 +181,24 @@ TEST(Config, ResolvedConfigurationKeepsImuSpecOverrides) {
 
 // The antenna section: the Doppler rows' velocity model (docs/fusion.md §13), its bad value, and config.resolved.yaml
 // (which did not write the section before session 7) reading back to the same values.
+TEST(Config, ElevationWeightKeyReachesTheEngineOptionsAndRoundTrips) {
+  const std::string files = "mode: tc\nrover_obs: r.obs\nnav: n.nav\nimu: {file: i.csv, spec: crista}\n";
+  auto def = parse(files);
+  ASSERT_TRUE(def) << def.error().message;
+  EXPECT_DOUBLE_EQ(def->gnss.elevation_weight, 1.0);
+  auto cfg = parse(files + "gnss: {elevation_weight: 0.3}\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_DOUBLE_EQ(cfg->gnss.elevation_weight, 0.3);
+  EXPECT_DOUBLE_EQ(engine_options(*cfg).weights.elevation_weight, 0.3);
+  EXPECT_DOUBLE_EQ(engine_options(*def).weights.elevation_weight, 1.0);
+  auto again = parse(to_yaml(*cfg));
+  ASSERT_TRUE(again) << again.error().message << "\n" << to_yaml(*cfg);
+  EXPECT_DOUBLE_EQ(again->gnss.elevation_weight, 0.3);
+  auto bad = parse(files + "gnss: {elevation_weight: 1.5}\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("gnss.elevation_weight"));
+}
+
 TEST(Config, AntennaVelocityModelKeysAndResolvedRoundTrip) {
   const std::string files = "mode: gnss\nrover_obs: r.obs\nnav: n.nav\n";
   auto def = parse(files);
