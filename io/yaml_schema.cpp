@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 namespace pednav::io {
@@ -242,8 +243,14 @@ void YamlMap::finish() {
   if (finished_) return;
   finished_ = true;
   if (absent(node_) || !node_.IsMap()) return;
+  // yaml-cpp keeps every pair of a mapping but looks up the first: a repeated key would be silently ignored.
+  std::map<std::string, int> first_line;
   for (const auto& kv : node_) {
     const std::string k = kv.first.as<std::string>("");
+    if (const auto [it, inserted] = first_line.emplace(k, kv.first.Mark().line + 1); !inserted) {
+      problems_->add(kv.first, key_path(k), "duplicate key (first at line " + std::to_string(it->second) + ")");
+      continue;
+    }
     if (!known_.count(k)) problems_->add(kv.first, key_path(k), "unknown key");
   }
 }

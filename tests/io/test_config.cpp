@@ -29,6 +29,16 @@ TEST(Config, UnknownKeyIsAnErrorWithPathAndLine) {
   EXPECT_THAT(cfg.error().message, HasSubstr("cfg.yaml:5: gnss.elevation_mask: unknown key"));
 }
 
+// yaml-cpp reads the first of two equal keys; a second `gnss:` appended to a file must not be silently ignored.
+TEST(Config, DuplicateKeyIsAnErrorNamingBothLines) {
+  auto top = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\ngnss:\n  elevation_mask_deg: 10\ngnss:\n  min_cn0_dbhz: 20\n");
+  ASSERT_FALSE(top);
+  EXPECT_THAT(top.error().message, HasSubstr("cfg.yaml:6: gnss: duplicate key (first at line 4)"));
+  auto nested = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\ngnss:\n  min_cn0_dbhz: 10\n  min_cn0_dbhz: 20\n");
+  ASSERT_FALSE(nested);
+  EXPECT_THAT(nested.error().message, HasSubstr("cfg.yaml:6: gnss.min_cn0_dbhz: duplicate key (first at line 5)"));
+}
+
 TEST(Config, WrongTypeNegativeRateAndBadEnumAreAllReportedAtOnce) {
   auto cfg = parse(
       "mode: gnss\nrover_obs: r.obs\nnav: n.nav\nmechanization_rate_hz: -5\n"
