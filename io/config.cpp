@@ -1,4 +1,3 @@
-#include <cmath>
 #include "io/config.hpp"
 
 #include <yaml-cpp/yaml.h>
