@@ -14,6 +14,7 @@
 #include <fstream>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
@@ -55,6 +56,7 @@ struct McOptions {
   bool gauss_markov_bias = false;  ///< Gauss-Markov bias model (the mode-ins default; tc uses the random walk)
   bool saturation_repair = true;   ///< reconstruct clipped IMU runs (`saturation: {repair: false}` to switch off)
   bool foot_antenna_velocity = false;  ///< Doppler rows with the foot's own velocity (`antenna: {velocity_model: foot}`)
+  std::optional<bool> scale_bias_compensation;  ///< scale_factors.bias_compensation (unset: the default)
   double elevation_weight = std::numeric_limits<double>::quiet_NaN();  ///< gnss.elevation_weight (NaN: the default)
 };
 
@@ -123,6 +125,7 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
   if (mo.no_scale_states) c.scale_factors.states = false;
   if (mo.gauss_markov_bias) c.bias.model = "gauss_markov";
   if (!std::isnan(mo.elevation_weight)) c.gnss.elevation_weight = mo.elevation_weight;
+  if (mo.scale_bias_compensation) c.scale_factors.bias_compensation = *mo.scale_bias_compensation;
   fusion::EngineOptions o = io::engine_options(c);
   if (mo.scale_states || mo.accel_scale_states) o.estimate_scale_factors = true;
   if (mo.scale_states) o.estimate_gyro_scale_factors = true;  // both blocks (the tc default since session 7)
@@ -446,6 +449,9 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
   cmd->add_option("--elevation-weight", mo->elevation_weight,
                   "k of the code/Doppler weight's elevation factor (gnss.elevation_weight, default 1; docs/gnss.md eq. W1)")
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--scale-bias-compensation", mo->scale_bias_compensation,
+                  "true/false: subtract the errors-in-variables bias of the scale-factor updates "
+                  "(scale_factors.bias_compensation; docs/consistency.md §3.6)");
   cmd->add_flag("--step-velocity", mo->step_velocity, "Seed 000 step-averaged velocity aiding");
   cmd->add_option("--leg-length-m", mo->leg_length_m, "Inverted-pendulum length l of the step-length model [m]")
       ->check(CLI::Range(0.05, 3.0));

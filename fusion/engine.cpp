@@ -148,6 +148,16 @@ class Filter {
         mp_last_ns_.assign(o.multipath_slots, kNeverNs);
       }
     }
+    if (o.scale_bias_compensation) {  // docs/consistency.md §3.6
+      for (const char* name : {ins::kScaleGyroBlock, ins::kScaleAccBlock}) {
+        const auto b = layout_.find(name);
+        if (!b) continue;
+        const bool gyro = std::string(name) == ins::kScaleGyroBlock;
+        for (int axis = 0; axis < 3; ++axis) {
+          eiv_.push_back(EivTerm{b->offset + axis, gyro ? ins::kAtt.offset : ins::kVel.offset, axis, gyro, {}});
+        }
+      }
+    }
     clock_m_.assign(n_clocks, 0.0);
   }
 
@@ -224,6 +234,7 @@ class Filter {
     // Smoother: the cross-covariance of the error at the last output epoch with the current error, Γ ← Γ Φᵀ
     // (docs/fusion.md eq. 12.15).
     if (recording_) interval_.predict(Phi_sparse_);
+    if (!eiv_.empty()) eiv_predict(inc.dt_s, x_.nav, after);
     covariance_predict(P_, Phi_sparse_, m.Qd, tmp_);
     x_.nav = after;
   }
@@ -243,11 +254,17 @@ class Filter {
     // Smoother: the estimate of the error at the last output epoch, its variance and its cross-covariance with the
     // current error are conditioned on the same measurement, with the filter's S and K (docs/fusion.md eqs.
     // 12.16-12.17).
-    const bool ok = recording_
-                        ? joseph_update(P_, H, r, R, dx,
-                                        [&](const auto& S_ldlt, const auto& K) { interval_.update(H, r, S_ldlt, K); })
-                        : joseph_update(P_, H, r, R, dx);
+    // Errors-in-variables compensation (docs/consistency.md eq. E.4): the mean noise part of each scale correction.
+    double eiv_bias[kMaxEivTerms];
+    const bool ok = joseph_update(P_, H, r, R, dx, [&](const auto& S_ldlt, const auto& K) {
+      if (recording_) interval_.update(H, r, S_ldlt, K);
+      for (size_t j = 0; j < eiv_.size(); ++j) eiv_bias[j] = eiv_update(eiv_[j].M, H, S_ldlt, K);
+    });
     if (!ok) return false;
+    for (size_t j = 0; j < eiv_.size(); ++j) {
+      dx(eiv_[j].state) -= eiv_bias[j];
+      eiv_[j].total += eiv_bias[j];
+    }
     apply(dx);
     return true;
   }
@@ -375,6 +392,37 @@ class Filter {
     return true;
   }
 
+  /// The IMU errors of the nominal state, their σ and the compensation totals (summary.json `imu_estimate`).
+  ImuEstimate imu_estimate() const {
+    ImuEstimate e;
+    e.value = x_.imu;
+    auto sd = [&](int offset) {
+      return Vector3d(std::sqrt(P_(offset, offset)), std::sqrt(P_(offset + 1, offset + 1)),
+                      std::sqrt(P_(offset + 2, offset + 2)));
+    };
+    e.sd.b_g = sd(ins::kBiasGyro.offset);
+    e.sd.b_a = sd(ins::kBiasAcc.offset);
+    if (const auto b = layout_.find(ins::kScaleGyroBlock)) {
+      e.gyro_scale = true;
+      e.sd.s_g = sd(b->offset);
+      for (int i = 0; i < 3; ++i) e.gyro_scale_compensation(i) = eiv_correction(b->offset + i);
+    }
+    if (const auto b = layout_.find(ins::kScaleAccBlock)) {
+      e.accel_scale = true;
+      e.sd.s_a = sd(b->offset);
+      for (int i = 0; i < 3; ++i) e.accel_scale_compensation(i) = eiv_correction(b->offset + i);
+    }
+    return e;
+  }
+
+  /// Sum of the errors-in-variables corrections subtracted from scale state `state` so far (docs/consistency.md §3.6).
+  double eiv_correction(int state) const {
+    for (const auto& t : eiv_) {
+      if (t.state == state) return t.total;
+    }
+    return 0.0;
+  }
+
   const ins::ErrorStateLayout& layout() const { return layout_; }
   ins::InsState& x() { return x_; }
   const ErrorMatrix& P() const { return P_; }
@@ -406,6 +454,55 @@ class Filter {
   std::vector<gnss::SatId> mp_sat_;
   std::vector<int64_t> mp_last_ns_;
   ColumnSparse<ins::kMaxErrorDim> Phi_sparse_;
+  // Errors-in-variables compensation of the scale-factor estimates (docs/consistency.md §3.6). The scale column of
+  // Φ is built from the measured increment, whose white noise ν also drives the error state: the noise part of
+  // P's column of scale state s and the noise part of the error are both Σ_k g_k ν_k (times P_ss), so every update
+  // moves ŝ by E[K_s r] = tr(S⁻¹ H M Hᵀ) on average, M = Σ_k P_ss σ_ν² g_k g_kᵀ (eq. E.4). M propagates like a
+  // covariance (Φ M Φᵀ + input, (I − K H) M (I − K H)ᵀ at updates) and that mean is subtracted.
+  static constexpr int kMaxEivTerms = 6;
+  struct EivTerm {
+    int state;         // scale state index
+    int block_offset;  // error block the sensor noise enters: attitude (gyro) or velocity (accelerometer)
+    int axis;          // body axis
+    bool gyro;
+    ErrorMatrix M;
+    double total = 0.0;
+  };
+  std::vector<EivTerm> eiv_;
+  ErrorMatrix eiv_tmp_, eiv_zero_;
+
+  void eiv_predict(double dt, const ins::NavState& before, const ins::NavState& after) {
+    const int n = layout_.dim();
+    if (eiv_zero_.rows() != n) eiv_zero_.setZero(n, n);
+    const Eigen::Matrix3d R = before.q_e_b.slerp(0.5, after.q_e_b).toRotationMatrix();
+    for (auto& t : eiv_) {
+      if (t.M.rows() != n) t.M.setZero(n, n);
+      covariance_predict(t.M, Phi_sparse_, eiv_zero_, eiv_tmp_);
+      const double psd = t.gyro ? spec_.gyro_arw * spec_.gyro_arw : spec_.accel_vrw * spec_.accel_vrw;
+      const Vector3d g = R.col(t.axis);
+      t.M.block<3, 3>(t.block_offset, t.block_offset).noalias() +=
+          (P_(t.state, t.state) * psd * dt) * (g * g.transpose());
+    }
+  }
+
+  // The mean noise-noise part of K_s r for one scale state, tr(S⁻¹ H M Hᵀ), and M ← (I − K H) M (I − K H)ᵀ.
+  template <typename MatH, typename Ldlt, typename MatK>
+  double eiv_update(ErrorMatrix& M, const MatH& H, const Ldlt& S_ldlt, const MatK& K) {
+    if (M.rows() != H.cols()) return 0.0;
+    using AMat = Eigen::Matrix<double, MatH::RowsAtCompileTime, Eigen::Dynamic, Eigen::ColMajor,
+                               MatH::MaxRowsAtCompileTime, ins::kMaxErrorDim>;
+    using SMat = Eigen::Matrix<double, MatH::RowsAtCompileTime, MatH::RowsAtCompileTime, Eigen::ColMajor,
+                               MatH::MaxRowsAtCompileTime, MatH::MaxRowsAtCompileTime>;
+    const AMat A = H * M;  // H M
+    const SMat B = A * H.transpose();
+    const double bias = S_ldlt.solve(B).trace();
+    // (I − K H) M (I − K H)ᵀ = M − K A − Aᵀ Kᵀ + K B Kᵀ
+    M.noalias() -= K * A;
+    M.noalias() -= A.transpose() * K.transpose();
+    M.noalias() += K * (B * K.transpose());
+    M = 0.5 * (M + M.transpose()).eval();
+    return bias;
+  }
   // Smoother: the interval since the last output epoch (docs/fusion.md eqs. 12.14-12.20), kept from the first
   // output epoch on.
   bool recording_ = false;
@@ -705,6 +802,7 @@ class Runner {
       if (failed) break;
     }
     if (pending) count(sum.gnss_skipped, "filter_diverged", pending->n_sats);
+    sum.imu_estimate = f.imu_estimate();
     if (gnss_pass) {
       sum.gnss_epochs_before_start += static_cast<long>(in_.rover->size() - gi);
       for (size_t g = gi; g < in_.rover->size(); ++g) {

@@ -79,6 +79,9 @@ struct EngineOptions {
   /// scale states are the ones that diverge on a clipped gyro (docs/consistency.md §3); the accelerometer scale
   /// errors are the ones that make the vertical dishonest (docs/consistency.md §3.2).
   bool estimate_gyro_scale_factors = true;
+  /// With estimate_scale_factors: subtract the errors-in-variables bias of the scale-factor updates (the scale
+  /// columns of Φ are built from the measured, noisy rate and specific force; docs/consistency.md §3.6).
+  bool scale_bias_compensation = false;
   /// IMU bias model of the filter. false: one first-order Gauss-Markov state per axis with the spec's instability σ
   /// and τ, started at the turn-on σ — its variance then decays towards the instability σ within ~τ whether or not
   /// anything observes the bias. true: the turn-on bias is a random constant and the instability a random walk of
@@ -136,6 +139,18 @@ struct EpochOutput {
   bool zupt = false;
 };
 
+/// The IMU errors the forward filter ended with (body axes), their σ, and for the scale factors the total the
+/// errors-in-variables compensation subtracted (docs/consistency.md §3.6). Scale entries are zero when the block
+/// is not estimated.
+struct ImuEstimate {
+  ins::ImuErrors value;
+  ins::ImuErrors sd;
+  Eigen::Vector3d gyro_scale_compensation = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_scale_compensation = Eigen::Vector3d::Zero();
+  bool gyro_scale = false;   ///< the gyro scale block was estimated
+  bool accel_scale = false;  ///< the accelerometer scale block was estimated
+};
+
 /// Counts for summary.json: every input accounted for.
 struct EngineSummary {
   long imu_samples = 0;
@@ -179,6 +194,7 @@ struct EngineSummary {
   long smoother_records = 0;         ///< stored backward maps (one per output epoch)
   long smoother_bytes = 0;           ///< heap bytes of the stored backward maps + nominal states at the outputs
   std::string smoother_message;      ///< why the smoother did not produce a solution (empty if it ran or is off)
+  ImuEstimate imu_estimate;          ///< at the end of the forward pass
 };
 
 /// One tested GNSS measurement of the forward filter's w-test (docs/fusion.md §6): what a user needs to audit the

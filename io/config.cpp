@@ -149,7 +149,8 @@ std::string to_yaml(const RunConfig& c) {
     << c.multipath.reset_gap_s << YAML::EndMap;
   const ImuErrorModelChoice m = imu_error_model_choice(c);  // written resolved: what this run's filter used
   e << YAML::Key << "scale_factors" << YAML::Value << YAML::BeginMap << YAML::Key << "states" << YAML::Value
-    << m.scale_states << YAML::Key << "gyro" << YAML::Value << c.scale_factors.gyro
+    << m.scale_states << YAML::Key << "gyro" << YAML::Value << c.scale_factors.gyro << YAML::Key
+    << "bias_compensation" << YAML::Value << c.scale_factors.bias_compensation
     << YAML::EndMap;
   e << YAML::Key << "bias" << YAML::Value << YAML::BeginMap << YAML::Key << "model" << YAML::Value
     << (m.bias_random_walk ? "random_walk" : "gauss_markov") << YAML::EndMap;

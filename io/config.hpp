@@ -142,6 +142,8 @@ struct ScaleFactorConfig {
   /// scale factor from the attitude and velocity errors the ZUPTs see (docs/consistency.md §3.3, §3.4).
   std::optional<bool> states;
   bool gyro = true;     ///< with scale-factor states: also the gyro block (false: accelerometer scale factors only)
+  /// Subtract the errors-in-variables bias of the scale-factor updates (docs/consistency.md §3.6).
+  bool bias_compensation = false;
 };
 
 /// `bias:` section: how the filter models the IMU biases (docs/consistency.md §3.2).

@@ -108,6 +108,7 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
       if (v == "false") out.scale_factors.states = false;
     }
     s.boolean("gyro", out.scale_factors.gyro);
+    s.boolean("bias_compensation", out.scale_factors.bias_compensation);
   }
   {
     YamlMap b = top.map("bias");

@@ -143,6 +143,7 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   const ImuErrorModelChoice m = imu_error_model_choice(c);
   o.estimate_scale_factors = m.scale_states;
   o.estimate_gyro_scale_factors = m.gyro_scale_states;
+  o.scale_bias_compensation = c.scale_factors.bias_compensation;
   o.bias_random_walk = m.bias_random_walk;
   o.repair_saturation = c.saturation.repair;
   return o;
@@ -285,6 +286,27 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
                               {"max_added_angle_deg", sum.saturation_max_added_deg},
                               {"notes", sum.saturation_notes}}}};
   j["mechanization_steps"] = sum.mechanization_steps;
+  {
+    const fusion::ImuEstimate& ie = sum.imu_estimate;
+    auto arr = [](const Eigen::Vector3d& v, double scale) {
+      return nlohmann::json::array({v.x() * scale, v.y() * scale, v.z() * scale});
+    };
+    nlohmann::json e = {{"gyro_bias_deg_per_h", arr(ie.value.b_g, kRadToDeg * 3600.0)},
+                        {"gyro_bias_sd_deg_per_h", arr(ie.sd.b_g, kRadToDeg * 3600.0)},
+                        {"accel_bias_mg", arr(ie.value.b_a, 1e3 / 9.80665)},
+                        {"accel_bias_sd_mg", arr(ie.sd.b_a, 1e3 / 9.80665)}};
+    if (ie.gyro_scale) {
+      e["gyro_scale_ppm"] = arr(ie.value.s_g, 1e6);
+      e["gyro_scale_sd_ppm"] = arr(ie.sd.s_g, 1e6);
+      e["gyro_scale_compensation_ppm"] = arr(ie.gyro_scale_compensation, 1e6);
+    }
+    if (ie.accel_scale) {
+      e["accel_scale_ppm"] = arr(ie.value.s_a, 1e6);
+      e["accel_scale_sd_ppm"] = arr(ie.sd.s_a, 1e6);
+      e["accel_scale_compensation_ppm"] = arr(ie.accel_scale_compensation, 1e6);
+    }
+    j["imu_estimate"] = e;
+  }
   j["zupt"] = {{"detector", c.zupt.detector}, {"form", c.zupt.form}, {"updates", sum.zupt_updates},
                {"stance_samples", sum.zupt_samples}};
   if (opt.mode == fusion::Mode::kTightlyCoupled) {
