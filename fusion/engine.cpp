@@ -182,6 +182,7 @@ class Filter {
       mp_value_[i] = 0.0;
       mp_last_ns_[i] = kNeverNs;
     }
+    for (auto& t : eiv_) t.M.setZero(layout_.dim(), layout_.dim());  // no noise footprint yet (also at a re-init)
     interval_.restart(P_);  // sized; the smoother's bookkeeping starts at the first output epoch (smoother_restart)
   }
 
