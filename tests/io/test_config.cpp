@@ -209,6 +209,22 @@ TEST(Config, ElevationWeightKeyReachesTheEngineOptionsAndRoundTrips) {
   EXPECT_THAT(bad.error().message, HasSubstr("gnss.elevation_weight"));
 }
 
+TEST(Config, ScaleBiasCompensationKeyReachesTheEngineOptionsAndRoundTrips) {
+  const std::string files = "mode: tc\nrover_obs: r.obs\nnav: n.nav\nimu: {file: i.csv, spec: crista}\n";
+  auto def = parse(files);
+  ASSERT_TRUE(def) << def.error().message;
+  EXPECT_FALSE(engine_options(*def).scale_bias_compensation);
+  auto cfg = parse(files + "scale_factors: {bias_compensation: true}\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_TRUE(engine_options(*cfg).scale_bias_compensation);
+  auto again = parse(to_yaml(*cfg));
+  ASSERT_TRUE(again) << again.error().message << "\n" << to_yaml(*cfg);
+  EXPECT_TRUE(again->scale_factors.bias_compensation);
+  auto bad = parse(files + "scale_factors: {bias_compensation: maybe}\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("scale_factors.bias_compensation"));
+}
+
 TEST(Config, AntennaVelocityModelKeysAndResolvedRoundTrip) {
   const std::string files = "mode: gnss\nrover_obs: r.obs\nnav: n.nav\n";
   auto def = parse(files);
