@@ -45,6 +45,23 @@ inline void covariance_predict(ins::ErrorMatrix& P, const ColumnSparse<ins::kMax
   mirror_upper(P);
 }
 
+/// X ← (I − K H) X (I − K H)ᵀ + K R Kᵀ for a symmetric X given U = X Hᵀ (n × m) and S = H U + R (m × m, symmetric):
+/// X − K Wᵀ − W Kᵀ with W = U − ½ K S (docs/fusion.md eq. 6.4), a symmetric rank-2m update on the upper triangle,
+/// mirrored — n(n+1)·m multiply-adds. With R = 0 it is the plain (I − K H) X (I − K H)ᵀ.
+template <typename MatU, typename MatK, typename MatS>
+inline void gain_downdate(ins::ErrorMatrix& X, const MatU& U, const MatK& K, const MatS& S) {
+  MatU W = U;
+  W.noalias() -= 0.5 * (K * S);
+  const Eigen::Index n = X.rows();
+  for (Eigen::Index j = 0; j < n; ++j) {
+    auto Xj = X.col(j).head(j + 1);
+    for (Eigen::Index k = 0; k < K.cols(); ++k) {
+      Xj -= W(j, k) * K.col(k).head(j + 1) + K(j, k) * W.col(k).head(j + 1);
+    }
+  }
+  mirror_upper(X);
+}
+
 /// Joseph-form Kalman update (Groves 2013 eqs. 3.18, 3.22): K = P Hᵀ (H P Hᵀ + R)⁻¹, dx = K r,
 /// P ← (I − K H) P (I − K H)ᵀ + K R Kᵀ, symmetrized. r: residuals (measured − predicted) [measurement units],
 /// H: Jacobian w.r.t. the error state (m × n), R: measurement noise covariance (m × m). Returns false (P and dx
@@ -84,16 +101,7 @@ bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR
   //                                 = P − K Wᵀ − W Kᵀ with W = U − ½ K S
   // (docs/fusion.md eq. 6.4): a symmetric rank-2m update, computed on the upper triangle and mirrored — n(n+1)·m
   // multiply-adds instead of the two n×m×n products of T = P − K H P, T − (T Hᵀ − K R) Kᵀ.
-  ColsMatrix W = PHt;
-  W.noalias() -= 0.5 * (K * S);
-  const Eigen::Index n = P.rows();
-  for (Eigen::Index j = 0; j < n; ++j) {
-    auto Pj = P.col(j).head(j + 1);
-    for (Eigen::Index k = 0; k < K.cols(); ++k) {
-      Pj -= W(j, k) * K.col(k).head(j + 1) + K(j, k) * W.col(k).head(j + 1);
-    }
-  }
-  mirror_upper(P);
+  gain_downdate(P, PHt, K, S);
   return true;
 }
 

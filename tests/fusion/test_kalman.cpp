@@ -94,6 +94,28 @@ TEST_P(KalmanSizes, JosephUpdateEqualsTheTextbookFormAndIsSymmetric) {
   EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-12);
 }
 
+// gain_downdate with R = 0 and a gain K that belongs to another matrix (the filter's P), as the errors-in-variables
+// footprints M use it (docs/consistency.md eq. E.3): M ← (I − K H) M (I − K H)ᵀ exactly, symmetric.
+TEST_P(KalmanSizes, GainDowndateWithZeroNoiseIsTheTwoSidedProjection) {
+  const int n = GetParam();
+  std::mt19937 rng(13u + static_cast<unsigned>(n));
+  std::normal_distribution<double> nd;
+  const ErrorMatrix M0 = random_spd(n, rng);
+  const Eigen::MatrixXd Kd = 0.2 * Eigen::MatrixXd::NullaryExpr(n, 3, [&]() { return nd(rng); });
+  Eigen::MatrixXd Hd = Eigen::MatrixXd::Zero(3, n);
+  for (int i = 0; i < 3; ++i) Hd(i, 3 + i) = 1.0, Hd(i, 6 + (i + 1) % 3) = 0.4 * nd(rng);
+  using U3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::ColMajor, ins::kMaxErrorDim, 3>;
+  const Eigen::MatrixXd Md = M0;
+  const U3 U = Md * Hd.transpose();
+  const Eigen::Matrix3d B = Hd * Md * Hd.transpose();
+  const U3 K = Kd;
+  ErrorMatrix M = M0;
+  fusion::gain_downdate(M, U, K, B);
+  const Eigen::MatrixXd IKH = Eigen::MatrixXd::Identity(n, n) - Kd * Hd;
+  EXPECT_LT(rel_diff(M, IKH * Md * IKH.transpose()), 1e-12);
+  EXPECT_EQ((M - M.transpose()).cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(Kalman, JosephUpdateRefusesANonPositiveInnovationCovariance) {
   const int n = 17;
   std::mt19937 rng(3u);
