@@ -81,7 +81,7 @@ struct EngineOptions {
   bool estimate_gyro_scale_factors = true;
   /// With estimate_scale_factors: subtract the errors-in-variables bias of the scale-factor updates (the scale
   /// columns of Φ are built from the measured, noisy rate and specific force; docs/consistency.md §3.6).
-  bool scale_bias_compensation = false;
+  bool scale_bias_compensation = true;
   /// IMU bias model of the filter. false: one first-order Gauss-Markov state per axis with the spec's instability σ
   /// and τ, started at the turn-on σ — its variance then decays towards the instability σ within ~τ whether or not
   /// anything observes the bias. true: the turn-on bias is a random constant and the instability a random walk of

@@ -143,7 +143,7 @@ struct ScaleFactorConfig {
   std::optional<bool> states;
   bool gyro = true;     ///< with scale-factor states: also the gyro block (false: accelerometer scale factors only)
   /// Subtract the errors-in-variables bias of the scale-factor updates (docs/consistency.md §3.6).
-  bool bias_compensation = false;
+  bool bias_compensation = true;
 };
 
 /// `bias:` section: how the filter models the IMU biases (docs/consistency.md §3.2).

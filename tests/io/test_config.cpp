@@ -213,13 +213,13 @@ TEST(Config, ScaleBiasCompensationKeyReachesTheEngineOptionsAndRoundTrips) {
   const std::string files = "mode: tc\nrover_obs: r.obs\nnav: n.nav\nimu: {file: i.csv, spec: crista}\n";
   auto def = parse(files);
   ASSERT_TRUE(def) << def.error().message;
-  EXPECT_FALSE(engine_options(*def).scale_bias_compensation);
-  auto cfg = parse(files + "scale_factors: {bias_compensation: true}\n");
+  EXPECT_TRUE(engine_options(*def).scale_bias_compensation);  // the default since session 10
+  auto cfg = parse(files + "scale_factors: {bias_compensation: false}\n");
   ASSERT_TRUE(cfg) << cfg.error().message;
-  EXPECT_TRUE(engine_options(*cfg).scale_bias_compensation);
+  EXPECT_FALSE(engine_options(*cfg).scale_bias_compensation);
   auto again = parse(to_yaml(*cfg));
   ASSERT_TRUE(again) << again.error().message << "\n" << to_yaml(*cfg);
-  EXPECT_TRUE(again->scale_factors.bias_compensation);
+  EXPECT_FALSE(again->scale_factors.bias_compensation);
   auto bad = parse(files + "scale_factors: {bias_compensation: maybe}\n");
   ASSERT_FALSE(bad);
   EXPECT_THAT(bad.error().message, HasSubstr("scale_factors.bias_compensation"));
