@@ -451,7 +451,7 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--scale-bias-compensation", mo->scale_bias_compensation,
                   "true/false: subtract the errors-in-variables bias of the scale-factor updates "
-                  "(scale_factors.bias_compensation; docs/consistency.md §3.6)");
+                  "(scale_factors.bias_compensation, default true; docs/consistency.md §3.6-3.7)");
   cmd->add_flag("--step-velocity", mo->step_velocity, "Seed 000 step-averaged velocity aiding");
   cmd->add_option("--leg-length-m", mo->leg_length_m, "Inverted-pendulum length l of the step-length model [m]")
       ->check(CLI::Range(0.05, 3.0));
