@@ -490,13 +490,18 @@ class Filter {
     if (n != layout_.dim()) eiv_Phi_.assign(model_.Phi.topLeftCorner(n, n));
     const auto& Phi = n != layout_.dim() ? eiv_Phi_ : Phi_sparse_;
     const Eigen::Matrix3d R = before.q_e_b.slerp(0.5, after.q_e_b).toRotationMatrix();
+    // The noise ν_u of every scale term u's regressor enters P's column of scale state t through P_tu (its own column
+    // of Φ times P_{s_u s_t}), and the error through g_u: M_t gains Σ_u P_tu σ_u² Δt g_u g_uᵀ (docs/consistency.md
+    // eq. E.5; only u = t in session 9).
     for (auto& t : eiv_) {
       if (t.M.rows() != n) t.M.setZero(n, n);
       covariance_predict(t.M, Phi, eiv_zero_, eiv_tmp_);
-      const double psd = t.gyro ? spec_.gyro_arw * spec_.gyro_arw : spec_.accel_vrw * spec_.accel_vrw;
-      const Vector3d g = R.col(t.axis);
-      t.M.block<3, 3>(t.block_offset, t.block_offset).noalias() +=
-          (P_(t.state, t.state) * psd * dt) * (g * g.transpose());
+      for (const auto& u : eiv_) {
+        const double psd = u.gyro ? spec_.gyro_arw * spec_.gyro_arw : spec_.accel_vrw * spec_.accel_vrw;
+        const Vector3d g = R.col(u.axis);
+        t.M.block<3, 3>(u.block_offset, u.block_offset).noalias() +=
+            (P_(t.state, u.state) * psd * dt) * (g * g.transpose());
+      }
     }
   }
 
