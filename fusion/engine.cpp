@@ -265,10 +265,7 @@ class Filter {
       if (recording_) interval_.update(H, r, S_ldlt, K);
       if (eiv_.empty()) return;
       int nz[ins::kMaxErrorDim];
-      int n_nz = 0;
-      for (int c = 0; c < H.cols(); ++c) {
-        if (!H.col(c).isZero(0.0)) nz[n_nz++] = c;
-      }
+      const int n_nz = nonzero_columns(H, nz);
       for (size_t j = 0; j < eiv_.size(); ++j) eiv_bias[j] = eiv_update(eiv_[j].M, H, nz, n_nz, S_ldlt, K);
     });
     if (!ok) return false;
@@ -521,12 +518,8 @@ class Filter {
     SMat B;  // H M Hᵀ
     B.noalias() = H.leftCols(ne) * U;
     const double bias = S_ldlt.solve(B).trace();
-    if (ne == K.rows()) {
-      gain_downdate(M, U, K, B);  // (I − K H) M (I − K H)ᵀ: the noise-free form (R = 0) of the Joseph update
-    } else {
-      const UMat Kt = K.topRows(ne);
-      gain_downdate(M, U, Kt, B);
-    }
+    // (I − K H) M (I − K H)ᵀ on the INS block: the noise-free form (R = 0) of the Joseph update.
+    gain_downdate(M, U, K.topRows(ne), B);
     return bias;
   }
   // Smoother: the interval since the last output epoch (docs/fusion.md eqs. 12.14-12.20), kept from the first

@@ -45,6 +45,16 @@ inline void covariance_predict(ins::ErrorMatrix& P, const ColumnSparse<ins::kMax
   mirror_upper(P);
 }
 
+/// The indices of H's columns that are not all zero, in increasing order, into nz (capacity H.cols()); their count.
+template <typename MatH>
+inline int nonzero_columns(const MatH& H, int* nz) {
+  int n = 0;
+  for (int c = 0; c < H.cols(); ++c) {
+    if (!H.col(c).isZero(0.0)) nz[n++] = c;
+  }
+  return n;
+}
+
 /// X ← (I − K H) X (I − K H)ᵀ + K R Kᵀ for a symmetric X given U = X Hᵀ (n × m) and S = H U + R (m × m, symmetric):
 /// X − K Wᵀ − W Kᵀ with W = U − ½ K S (docs/fusion.md eq. 6.4), a symmetric rank-2m update on the upper triangle,
 /// mirrored — n(n+1)·m multiply-adds. With R = 0 it is the plain (I − K H) X (I − K H)ᵀ.
@@ -78,10 +88,7 @@ bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR
   // H of a ZUPT or GNSS epoch touches a few states only (ZUPT: velocity, attitude, gyro bias): P Hᵀ and T Hᵀ are
   // summed over H's non-zero columns (n·m per column instead of n·n·m for the whole product).
   int nz[ins::kMaxErrorDim];
-  int n_nz = 0;
-  for (int c = 0; c < H.cols(); ++c) {
-    if (!H.col(c).isZero(0.0)) nz[n_nz++] = c;
-  }
+  const int n_nz = nonzero_columns(H, nz);
   auto times_Ht = [&](const ins::ErrorMatrix& A, ColsMatrix& out) {
     out.setZero(A.rows(), H.rows());
     for (int k = 0; k < n_nz; ++k) out.noalias() += A.col(nz[k]) * H.col(nz[k]).transpose();
