@@ -29,6 +29,7 @@
 #include "io/log.hpp"
 #include "io/run_command.hpp"
 #include "io/scenario_config.hpp"
+#include "sim/gnss_sim.hpp"
 #include "sim/simulator.hpp"
 
 namespace pednav::apps {
@@ -58,6 +59,7 @@ struct McOptions {
   bool foot_antenna_velocity = false;  ///< Doppler rows with the foot's own velocity (`antenna: {velocity_model: foot}`)
   std::optional<bool> scale_bias_compensation;  ///< scale_factors.bias_compensation (unset: the default)
   double elevation_weight = std::numeric_limits<double>::quiet_NaN();  ///< gnss.elevation_weight (NaN: the default)
+  bool receiver_weights = false;   ///< code/Doppler weights from the scenario's receiver model (docs/consistency.md §3.8)
 };
 
 // One finished run (what runs.csv shows), with its per-epoch errors.
@@ -124,6 +126,13 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
   c.smoother_enabled = mo.smoother;
   if (mo.no_scale_states) c.scale_factors.states = false;
   if (mo.gauss_markov_bias) c.bias.model = "gauss_markov";
+  if (mo.receiver_weights) {  // the filter's code and Doppler weights = the simulated receiver (docs/consistency.md §3.8)
+    const gnss::WeightModel w = sim::receiver_weight_model(sc.gnss);
+    c.gnss.cn0_ref_dbhz = w.cn0_ref_dbhz;
+    c.gnss.code_sigma_zenith_m = w.code_sigma_zenith_m;
+    c.gnss.doppler_sigma_zenith_mps = w.doppler_sigma_zenith_mps;
+    c.gnss.elevation_weight = w.elevation_weight;
+  }
   if (!std::isnan(mo.elevation_weight)) c.gnss.elevation_weight = mo.elevation_weight;
   if (mo.scale_bias_compensation) c.scale_factors.bias_compensation = *mo.scale_bias_compensation;
   fusion::EngineOptions o = io::engine_options(c);
@@ -449,6 +458,9 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
   cmd->add_option("--elevation-weight", mo->elevation_weight,
                   "k of the code/Doppler weight's elevation factor (gnss.elevation_weight, default 1; docs/gnss.md eq. W1)")
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_flag("--receiver-weights", mo->receiver_weights,
+                "Code/Doppler weights from the scenario's receiver model (DLL thermal noise at its zenith C/N0, no "
+                "elevation factor unless --elevation-weight; docs/consistency.md §3.8) instead of pednav run's defaults");
   cmd->add_option("--scale-bias-compensation", mo->scale_bias_compensation,
                   "true/false: subtract the errors-in-variables bias of the scale-factor updates "
                   "(scale_factors.bias_compensation, default true; docs/consistency.md §3.6-3.7)");

@@ -272,6 +272,9 @@ class Filter {
     for (size_t j = 0; j < eiv_.size(); ++j) {
       dx(eiv_[j].state) -= eiv_bias[j];
       eiv_[j].total += eiv_bias[j];
+      // The smoother conditions on the same residual: without this its scale estimate at the interval's start would
+      // take the subtraction back (docs/consistency.md eq. E.6).
+      if (recording_) interval_.shift_mean(eiv_[j].state, -eiv_bias[j]);
     }
     apply(dx);
     return true;
@@ -734,7 +737,7 @@ class Runner {
       if (stance) last_stance = f.x();
       if (output_now) {
         while (next_out_ns <= inc.t1.ns()) next_out_ns += out_period_ns;
-        result.epochs.push_back(output(f.x().nav, f.P(), inc.t1, stance, last_used, last_rejected));
+        result.epochs.push_back(output(f.x(), f.P(), inc.t1, stance, last_used, last_rejected));
         last_used = last_rejected = 0;
         if (smooth && !reinitialized_at) {
           if (segment_open) {
@@ -853,7 +856,7 @@ class Runner {
         // Smoothed state = forward nominal ⊞ smoothed error (eq. 12.12).
         const ins::InsState xs = ins::boxplus(nominal_at_output[k], dx, f.layout());
         const EpochOutput& fwd = result.epochs[k];
-        result.smoothed[k] = output(xs.nav, P, fwd.t, fwd.zupt, fwd.n_sats_used, fwd.n_sats_rejected);
+        result.smoothed[k] = output(xs, P, fwd.t, fwd.zupt, fwd.n_sats_used, fwd.n_sats_rejected);
         if (finite && (!xs.nav.p_eb_e.allFinite() || !P.allFinite())) {
           finite = false;
           bad = k;
@@ -915,10 +918,12 @@ class Runner {
   }
 
   // One output epoch from a nominal navigation state and the covariance of its error (forward or smoothed).
-  EpochOutput output(const ins::NavState& nav, const ErrorMatrix& P, GpsTime t, bool zupt, int used, int rejected) const {
+  EpochOutput output(const ins::InsState& x, const ErrorMatrix& P, GpsTime t, bool zupt, int used, int rejected) const {
     EpochOutput e;
     e.t = t;
-    e.nav = nav;
+    e.nav = x.nav;
+    e.imu = x.imu;
+    const ins::NavState& nav = x.nav;
     const Geodetic llh = geodetic_from_ecef(e.nav.p_eb_e);
     const Eigen::Matrix3d Rne = R_e_n(llh.lat, llh.lon).transpose();
     Eigen::Matrix3d cov_p_e = P.block<3, 3>(ins::kPos.offset, ins::kPos.offset);

@@ -132,6 +132,7 @@ struct EngineInputs {
 struct EpochOutput {
   GpsTime t;
   ins::NavState nav;
+  ins::ImuErrors imu;  ///< the IMU error estimates (biases, scale factors) at this epoch, forward or smoothed
   Eigen::Matrix3d cov_p_n = Eigen::Matrix3d::Zero();  ///< position covariance, NED [m^2]
   Eigen::Matrix3d cov_v_n = Eigen::Matrix3d::Zero();
   double sd_yaw_rad = 0.0;

@@ -99,6 +99,12 @@ class RtsInterval {
   void reexpress(int dst, int src, const Eigen::Matrix3d& B);
   /// The same for a general (dense) J.
   void reexpress(const ErrorMatrix& J);
+  /// The filter fed back K r + delta instead of K r at state i, a state without process noise over the interval
+  /// (a constant, or a slow Gauss-Markov state: the scale factors), and asserts the error after the update has zero
+  /// mean (the errors-in-variables compensation of docs/consistency.md eq. E.4). For such a state Γ's row equals P's
+  /// row (δx_a,i = δx_j,i + the corrections fed back since a), so E[δx_a,i | Y] moves by delta too: μ_i += delta
+  /// (docs/consistency.md eq. E.6; the regression of δx_a's other components on the deviation is left out).
+  void shift_mean(int i, double delta) { mu_(i) += delta; }
   /// State i restarted as a fresh variable independent of everything before (clock, drift, multipath slot reset,
   /// docs/fusion.md §7, §12.4): Γ.col(i) ← 0 (eq. 12.19).
   void restart_state(int i);

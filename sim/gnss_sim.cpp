@@ -85,6 +85,16 @@ double doppler_sigma_mps(const GnssOptions& o, double cn0_dbhz) {
   return o.doppler_sigma_mps * std::pow(10.0, std::max(0.0, o.multipath_cn0_ref_dbhz - cn0_dbhz) / 20.0);
 }
 
+gnss::WeightModel receiver_weight_model(const GnssOptions& o) {
+  gnss::WeightModel w;
+  w.cn0_ref_dbhz = o.cn0_zenith_dbhz;
+  w.code_sigma_zenith_m = thermal_code_sigma_m(o, o.cn0_zenith_dbhz);
+  // doppler_sigma_mps(cn0) = σ_d 10^((ref_mp − cn0)/20) below ref_mp = [σ_d 10^((ref_mp − zenith)/20)] 10^((zenith − cn0)/20).
+  w.doppler_sigma_zenith_mps = o.doppler_sigma_mps * std::pow(10.0, (o.multipath_cn0_ref_dbhz - o.cn0_zenith_dbhz) / 20.0);
+  w.elevation_weight = 0.0;
+  return w;
+}
+
 GnssSimulation simulate_gnss(const GnssOptions& o, const gnss::NavData& nav, const AntennaFunction& rover_antenna,
                              const Eigen::Vector3d& p_base_e, GpsTime t_begin, GpsTime t_end, uint64_t seed) {
   GnssSimulation out;

@@ -8,6 +8,7 @@
 // accelerometer noise reaches its column through the covariances with the other scale states).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -105,6 +106,47 @@ TEST(ScaleBiasCompensation, RollGyroAndVerticalAccelScalesStayNearZeroOnlyWithTh
   EXPECT_LT(roll[1], kMaxRollWith);
   EXPECT_GT(vertical[0], kMinVerticalAccelWithout);
   EXPECT_LT(vertical[1], kMaxVerticalAccelWith);  // fails without the cross terms (0.0065)
+}
+
+// The smoother conditions on the same residuals as the forward filter. The scale factors are random constants (no
+// process noise), so their smoothed value is one number over the whole run, and with the compensation it must be
+// the forward filter's final (compensated) estimate at every epoch (docs/consistency.md eq. E.6). Without telling the
+// smoother about the subtraction (RtsInterval::shift_mean) its roll-gyro estimate at the start of the walk was the
+// final estimate plus everything subtracted (1.6 % on this walk): the smoothed early epochs used the biased scale.
+constexpr double kMaxSmoothedScaleDrift = 1e-6;  // [-] max over epochs |ŝ(t) − ŝ(end)|, any axis
+constexpr double kMinSubtracted = 0.005;         // [-] the roll subtraction must be large for the test to mean anything
+
+TEST(ScaleBiasCompensation, SmoothedScaleFactorsAreConstantAndKeepTheSubtraction) {
+  auto filter_spec = ins::imu_spec_preset("crista");
+  ASSERT_TRUE(filter_spec.has_value());
+  auto file = io::parse_scenario(kNoiseOnlyWalk, "scale_bias.yaml", ".");
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  auto s = sim::simulate(file->scenario);
+  ASSERT_TRUE(s.has_value()) << s.error().message;
+  io::RunConfig c;
+  c.mode = "tc";
+  c.imu.spec = *filter_spec;
+  c.smoother_enabled = true;
+  c.scale_factors.bias_compensation = true;
+  fusion::EngineOptions o = io::engine_options(c);
+  o.base_position_e = s->gnss.p_base_e;
+  auto r = fusion::run_forward(test::engine_inputs(*s), o);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  ASSERT_TRUE(r->summary.smoothed) << r->summary.smoother_message;
+  ASSERT_FALSE(r->smoothed.empty());
+  const fusion::ImuEstimate& e = r->summary.imu_estimate;
+  const ins::ImuErrors& last = r->smoothed.back().imu;
+  double drift = 0.0;
+  for (const auto& ep : r->smoothed) {
+    drift = std::max({drift, (ep.imu.s_g - last.s_g).cwiseAbs().maxCoeff(), (ep.imu.s_a - last.s_a).cwiseAbs().maxCoeff()});
+  }
+  const ins::ImuErrors& first = r->smoothed.front().imu;
+  std::printf("[ scale bias ] smoothed s_g x first %+.5f last %+.5f (forward final %+.5f, subtracted %+.5f); max "
+              "drift of any smoothed scale over the run %.2e\n",
+              first.s_g.x(), last.s_g.x(), e.value.s_g.x(), e.gyro_scale_compensation.x(), drift);
+  EXPECT_GT(e.gyro_scale_compensation.x(), kMinSubtracted);
+  EXPECT_LT(drift, kMaxSmoothedScaleDrift);
+  EXPECT_NEAR(last.s_g.x(), e.value.s_g.x(), kMaxSmoothedScaleDrift);  // at the end smoothed = filtered
 }
 
 }  // namespace

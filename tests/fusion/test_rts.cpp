@@ -365,6 +365,104 @@ TEST(RtsInterval, EqualsPerStepCompositionWithReexpressionsAndResets) {
               worst_dx, worst_P, smoothing);
 }
 
+// A feedback that is not K r (the errors-in-variables compensation of the scale-factor updates subtracts a bias from
+// the correction of a constant state, docs/consistency.md eq. E.4): the per-step reference takes d = the correction
+// actually fed back, and the interval bookkeeping is told the deviation with shift_mean (eq. E.6). For a state without
+// process noise the smoothed estimate of that state (nominal + smoothed error) is one constant over the run, and both
+// formulations give it; without shift_mean the interval one drifts back by the deviations (what the engine's smoother
+// did before session 11).
+TEST(RtsInterval, FeedbackDeviationOnAConstantStateKeepsItsSmoothedValueConstant) {
+  std::mt19937 rng(20261202u);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  constexpr int n = 6, kConst = 5, kSteps = 120, kEvery = 7;
+  const MatrixXd I = MatrixXd::Identity(n, n);
+  MatrixXd P = random_spd(rng, n, 1.0);
+  VectorXd nominal = VectorXd::Zero(n);  // the closed-loop nominal of the constant state is what is compared
+  fusion::RtsAccumulator acc(n);
+  fusion::RtsInterval shifted(n), plain(n);
+  std::vector<fusion::RtsSegment> ref_seg, shifted_seg, plain_seg;
+  std::vector<double> nominal_at_output;
+  bool open = false;
+  double deviation_total = 0.0;
+  for (int k = 0; k < kSteps; ++k) {
+    MatrixXd Phi = I;
+    for (int i = 0; i < n - 1; ++i) {
+      for (int j = 0; j < n; ++j) Phi(i, j) += 0.05 * nd(rng);
+    }
+    MatrixXd Qd = random_spd(rng, n, 1e-3);
+    Qd.row(kConst).setZero();
+    Qd.col(kConst).setZero();
+    const MatrixXd P_post = P;
+    P = Phi * P * Phi.transpose() + Qd;
+    if (open) {
+      shifted.predict(Phi);
+      plain.predict(Phi);
+    }
+    const MatrixXd P_prior = P;
+    VectorXd d = VectorXd::Zero(n);
+    MatrixXd H(2, n);
+    for (int i = 0; i < 2; ++i) {
+      for (int j = 0; j < n; ++j) H(i, j) = nd(rng);
+    }
+    H.col(kConst).setZero();  // as for a scale factor: no measurement sees it directly
+    const MatrixXd R = random_spd(rng, 2, 0.1);
+    const MatrixXd S = H * P * H.transpose() + R;
+    const Eigen::LDLT<MatrixXd> ldlt(S);
+    const MatrixXd K = ldlt.solve(H * P).transpose();
+    const VectorXd r = Eigen::LLT<MatrixXd>(S).matrixL() * VectorXd::NullaryExpr(2, [&] { return nd(rng); });
+    if (open) {
+      shifted.update(H, r, ldlt, K);
+      plain.update(H, r, ldlt, K);
+    }
+    VectorXd dx = K * r;
+    const double deviation = 0.02 * std::sqrt(P(kConst, kConst)) * (1.0 + 0.5 * nd(rng));  // a bias, one sign
+    dx(kConst) -= deviation;
+    if (open) shifted.shift_mean(kConst, -deviation);
+    if (open) deviation_total += deviation;
+    nominal += dx;
+    d += dx;
+    const MatrixXd IKH = I - K * H;
+    P = IKH * P * IKH.transpose() + K * R * K.transpose();
+    if (open) acc.append(fusion::rts_step(P_post, Phi, P_prior, I, d));
+    if ((k + 1) % kEvery == 0) {
+      if (open) {
+        ref_seg.push_back(acc.take());
+        shifted_seg.emplace_back();
+        shifted.close(P, shifted_seg.back());
+        plain_seg.emplace_back();
+        plain.close(P, plain_seg.back());
+      }
+      shifted.restart(P);
+      plain.restart(P);
+      open = true;
+      nominal_at_output.push_back(nominal(kConst));
+    }
+  }
+  auto tail = [&](fusion::RtsInterval& iv) {
+    fusion::RtsSegment t;
+    iv.close(P, t);
+    return t;
+  };
+  const auto ref = fusion::rts_backward(ref_seg, acc.take(), P);
+  const auto got = fusion::rts_backward(shifted_seg, tail(shifted), P);
+  const auto old = fusion::rts_backward(plain_seg, tail(plain), P);
+  ASSERT_EQ(ref.size(), nominal_at_output.size());
+  const double sigma = std::sqrt(P(kConst, kConst));
+  const double final_value = nominal_at_output.back() + ref.back().dx(kConst);
+  double worst_ref = 0.0, worst_got = 0.0, worst_old = 0.0;
+  for (size_t i = 0; i < ref.size(); ++i) {
+    worst_ref = std::max(worst_ref, std::abs(nominal_at_output[i] + ref[i].dx(kConst) - final_value) / sigma);
+    worst_got = std::max(worst_got, std::abs(nominal_at_output[i] + got[i].dx(kConst) - final_value) / sigma);
+    worst_old = std::max(worst_old, std::abs(nominal_at_output[i] + old[i].dx(kConst) - final_value) / sigma);
+  }
+  std::printf("[ rts ] constant state, %zu outputs, deviations %.2f final σ in all: smoothed value off its final one by "
+              "%.1e σ (reference), %.1e σ (shift_mean), %.2f σ (without)\n",
+              ref.size(), deviation_total / sigma, worst_ref, worst_got, worst_old);
+  EXPECT_LT(worst_ref, kTolRel);
+  EXPECT_LT(worst_got, kTolRel);
+  EXPECT_GT(worst_old, 0.5);  // the defect is visible without the shift, else the test proves nothing
+}
+
 TEST(RtsStep, ResetFoldedIntoTransitionDecouplesTheState) {
   // A state reset (fresh variable, docs/fusion.md eq. 12.11) is a transition row of zeros: the smoothed error
   // before the reset is then the regression of that state on the others, and a later correction of the reset

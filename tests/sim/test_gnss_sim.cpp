@@ -10,6 +10,7 @@
 #include "gnss/ephemeris.hpp"
 #include "gnss/measurement.hpp"
 #include "sim/constellation.hpp"
+#include "sim/gnss_sim.hpp"
 #include "sim/simulator.hpp"
 #include "tests/sim/fixtures.hpp"
 
@@ -127,6 +128,41 @@ TEST(GnssSim, BlundersAppearAtTheConfiguredRateAndAreRecorded) {
     ++checked;
   }
   EXPECT_GT(checked, 20);
+}
+
+// sim::receiver_weight_model: the filter's eq. W1 weights that describe the simulated receiver (pednav montecarlo
+// --receiver-weights). Code: the DLL thermal σ within the squaring loss the W1 form cannot carry; Doppler: the
+// simulated σ wherever the C/N0 is at or below the multipath reference; no elevation factor. Checked on the
+// forest_walk receiver (0.3 Hz DLL, 0.5 chip) and on the defaults (1 Hz, 1 chip: 2.6× noisier at 45 dB-Hz).
+TEST(GnssSim, ReceiverWeightModelReproducesTheSimulatedCodeAndDopplerNoise) {
+  sim::GnssOptions forest;
+  forest.cn0_zenith_dbhz = 49.0;
+  forest.dll_bandwidth_hz = 0.3;
+  forest.correlator_spacing_chips = 0.5;
+  for (const sim::GnssOptions& o : {forest, sim::GnssOptions{}}) {
+    const gnss::WeightModel w = sim::receiver_weight_model(o);
+    EXPECT_EQ(w.elevation_weight, 0.0);
+    EXPECT_EQ(w.cn0_ref_dbhz, o.cn0_zenith_dbhz);
+    for (double cn0 = 25.0; cn0 <= o.cn0_zenith_dbhz; cn0 += 1.0) {
+      for (double el_deg : {15.0, 45.0, 90.0}) {
+        const double code = gnss::measurement_sigma(w, cn0, el_deg * kDegToRad, false);
+        const double truth = sim::thermal_code_sigma_m(o, cn0);
+        // W1 lacks the squaring loss 1 + 2/((2 − d) T cn0): the ratio is its square root, ≤ 1.
+        const double cn0_lin = std::pow(10.0, cn0 / 10.0);
+        const double loss = std::sqrt(1.0 + 2.0 / ((2.0 - o.correlator_spacing_chips) * o.integration_time_s * cn0_lin));
+        const double loss_ref = std::sqrt(
+            1.0 + 2.0 / ((2.0 - o.correlator_spacing_chips) * o.integration_time_s * std::pow(10.0, o.cn0_zenith_dbhz / 10.0)));
+        EXPECT_NEAR(code / truth, loss_ref / loss, 1e-12) << "C/N0 " << cn0 << " el " << el_deg;
+        EXPECT_GT(code / truth, cn0 >= 30.0 ? 0.95 : 0.87) << "C/N0 " << cn0;
+        if (cn0 <= o.multipath_cn0_ref_dbhz) {
+          EXPECT_NEAR(gnss::measurement_sigma(w, cn0, el_deg * kDegToRad, true), sim::doppler_sigma_mps(o, cn0), 1e-12);
+        }
+      }
+    }
+  }
+  EXPECT_NEAR(sim::receiver_weight_model(sim::GnssOptions{}).code_sigma_zenith_m /
+                  sim::receiver_weight_model(forest).code_sigma_zenith_m,
+              std::sqrt(1.0 * 1.0 / (0.3 * 0.5)), 0.01);  // σ ∝ sqrt(B d)
 }
 
 TEST(Constellation, NominalGpsConstellationGeometry) {
