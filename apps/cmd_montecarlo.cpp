@@ -132,6 +132,7 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
     c.gnss.code_sigma_zenith_m = w.code_sigma_zenith_m;
     c.gnss.doppler_sigma_zenith_mps = w.doppler_sigma_zenith_mps;
     c.gnss.elevation_weight = w.elevation_weight;
+    c.gnss.code_squaring_loss = w.code_squaring_loss;
   }
   if (!std::isnan(mo.elevation_weight)) c.gnss.elevation_weight = mo.elevation_weight;
   if (mo.scale_bias_compensation) c.scale_factors.bias_compensation = *mo.scale_bias_compensation;

@@ -150,9 +150,13 @@ double measurement_sigma(const WeightModel& m, double cn0_dbhz, double elevation
   const double cn0_factor = std::pow(10.0, std::max(0.0, m.cn0_ref_dbhz - cn0) / 20.0);
   const double el = std::max(elevation_rad, m.min_elevation_for_weight_rad);
   const double sin_el = std::sin(el);
+  // Eq. W2: the DLL's squaring loss 1 + 2/((2 − d) T C/N0) grows like c² below cn0_ref (Kaplan & Hegarty eq. 7.88).
+  const double loss = !doppler && m.code_squaring_loss > 0.0
+                          ? std::sqrt((1.0 + m.code_squaring_loss * cn0_factor * cn0_factor) / (1.0 + m.code_squaring_loss))
+                          : 1.0;
   // k = 1 in its closed form, so the default weights stay bit-identical to the model before eq. W1.
-  if (m.elevation_weight == 1.0) return sigma0 * cn0_factor / sin_el;
-  return sigma0 * cn0_factor * std::sqrt(1.0 + m.elevation_weight * (1.0 / (sin_el * sin_el) - 1.0));
+  if (m.elevation_weight == 1.0) return sigma0 * cn0_factor * loss / sin_el;
+  return sigma0 * cn0_factor * loss * std::sqrt(1.0 + m.elevation_weight * (1.0 / (sin_el * sin_el) - 1.0));
 }
 
 }  // namespace pednav::gnss

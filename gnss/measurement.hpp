@@ -84,6 +84,7 @@ double saastamoinen_delay_m(const Geodetic& llh, double elevation_rad);
 
 /// Code and Doppler noise model (docs/gnss.md "Weighting", eq. W1): sigma = sigma_zenith * 10^((cn0_ref - C/N0)/20)
 /// * sqrt(1 + k (1/sin^2(el) - 1)), the C/N0 factor applied only below cn0_ref; a missing C/N0 counts as cn0_ref.
+/// Eq. W2: the code sigma times sqrt((1 + b c^2) / (1 + b)) when code_squaring_loss b > 0.
 /// k = elevation_weight: 1 gives sigma_zenith * c / sin(el) (RTKLIB's form), 0 the C/N0 factor alone.
 struct WeightModel {
   double code_sigma_zenith_m = 0.4;      ///< code noise at zenith and C/N0 >= cn0_ref [m]
@@ -92,6 +93,9 @@ struct WeightModel {
   double min_elevation_for_weight_rad = 5.0 * kDegToRad;  ///< 1/sin(el) is capped at this elevation
   double glonass_code_factor = 3.0;      ///< GLONASS code sigma / GPS (x2 chip length, x1.5 FDMA biases)
   double elevation_weight = 1.0;         ///< k of eq. W1, in [0, 1]: the share of the 1/sin^2(el) variance factor
+  /// b of eq. W2: the DLL squaring loss at cn0_ref (2 / ((2 − d) T C/N0_ref) for correlator spacing d [chips] and
+  /// coherent integration T [s]); the code variance gets (1 + b c²) / (1 + b), c = the C/N0 factor. 0: off.
+  double code_squaring_loss = 0.0;
 };
 /// Standard deviation [m or m/s] of one receiver's code (doppler=false) or range rate (doppler=true).
 double measurement_sigma(const WeightModel& model, double cn0_dbhz, double elevation_rad, bool doppler);

@@ -106,6 +106,7 @@ std::string to_yaml(const RunConfig& c) {
   e << YAML::Key << "cn0_ref_dbhz" << YAML::Value << c.gnss.cn0_ref_dbhz;
   e << YAML::Key << "glonass_code_factor" << YAML::Value << c.gnss.glonass_code_factor;
   e << YAML::Key << "elevation_weight" << YAML::Value << c.gnss.elevation_weight;
+  e << YAML::Key << "code_squaring_loss" << YAML::Value << c.gnss.code_squaring_loss;
   e << YAML::Key << "code_smoothing_s" << YAML::Value << c.gnss.code_smoothing_s;
   e << YAML::EndMap;
   if (!c.imu.file.empty()) {

@@ -42,6 +42,8 @@ struct GnssConfig {
   /// k of the weight model's elevation factor sqrt(1 + k (1/sin^2 el - 1)) (docs/gnss.md eq. W1), for the epoch
   /// least squares and the filter's rows alike; 1 = sigma_zenith * c / sin(el).
   double elevation_weight = 1.0;
+  /// b of docs/gnss.md eq. W2: the DLL squaring loss at cn0_ref_dbhz, 2 / ((2 − d) T C/N0_ref); 0 = off.
+  double code_squaring_loss = 0.0;
 };
 
 /// `imu:` section.

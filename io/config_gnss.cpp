@@ -37,6 +37,7 @@ void read_gnss_section(YamlMap& top, GnssConfig& out) {
   g.number("cn0_ref_dbhz", out.cn0_ref_dbhz, false, 10.0, 70.0);
   g.number("glonass_code_factor", out.glonass_code_factor, false, 0.1, 100.0);
   g.number("elevation_weight", out.elevation_weight, false, 0.0, 1.0);
+  g.number("code_squaring_loss", out.code_squaring_loss, false, 0.0, 10.0);
   g.number("code_smoothing_s", out.code_smoothing_s, false, 0.0, 3600.0);
 }
 

@@ -184,6 +184,7 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
   opt.weights.cn0_ref_dbhz = g.cn0_ref_dbhz;
   opt.weights.glonass_code_factor = g.glonass_code_factor;
   opt.weights.elevation_weight = g.elevation_weight;
+  opt.weights.code_squaring_loss = g.code_squaring_loss;
 
   std::vector<SolutionRow> rows;
   rows.reserve(rover->epochs.size());

@@ -118,6 +118,7 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.weights.cn0_ref_dbhz = c.gnss.cn0_ref_dbhz;
   o.weights.glonass_code_factor = c.gnss.glonass_code_factor;
   o.weights.elevation_weight = c.gnss.elevation_weight;
+  o.weights.code_squaring_loss = c.gnss.code_squaring_loss;
   o.use_doppler = c.gnss.use_doppler;
   o.max_base_age_s = c.gnss.max_base_age_s;
   o.lever_arm_n_m = c.antenna.lever_arm_ned_m;

@@ -92,6 +92,8 @@ gnss::WeightModel receiver_weight_model(const GnssOptions& o) {
   // doppler_sigma_mps(cn0) = σ_d 10^((ref_mp − cn0)/20) below ref_mp = [σ_d 10^((ref_mp − zenith)/20)] 10^((zenith − cn0)/20).
   w.doppler_sigma_zenith_mps = o.doppler_sigma_mps * std::pow(10.0, (o.multipath_cn0_ref_dbhz - o.cn0_zenith_dbhz) / 20.0);
   w.elevation_weight = 0.0;
+  w.code_squaring_loss =
+      2.0 / ((2.0 - o.correlator_spacing_chips) * o.integration_time_s * std::pow(10.0, o.cn0_zenith_dbhz / 10.0));
   return w;
 }
 

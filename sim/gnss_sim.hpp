@@ -60,9 +60,10 @@ double doppler_sigma_mps(const GnssOptions& options, double cn0_dbhz);
 /// would configure from the receiver's data sheet; `pednav montecarlo --receiver-weights`, docs/consistency.md §3.8).
 /// Eq. W1's C/N0 factor is the DLL thermal noise's own 1/sqrt(C/N0) law, so σ₀ = the thermal σ at the zenith C/N0
 /// (the highest the scenario has, used as cn0_ref) and no elevation factor (the simulated noise depends on the
-/// elevation only through the C/N0). Left out: the DLL's squaring loss (W1 is low by ≤ 3 % above 30 dB-Hz, 10 % at
-/// 25 dB-Hz for T = 20 ms, d = 0.5) and the Doppler noise's floor at the multipath reference C/N0 (W1 keeps falling up
-/// to the zenith C/N0). Multipath is not in it: it is a separate, correlated error (the filter's multipath states).
+/// elevation only through the C/N0); the DLL's squaring loss as eq. W2's b = 2 / ((2 − d) T C/N0_zenith), so the code
+/// σ is the thermal σ at every C/N0. Left out: the Doppler noise's floor at the multipath reference C/N0 (W1 keeps
+/// falling up to the zenith C/N0). Multipath is not in it: it is a separate, correlated error (the filter's multipath
+/// states).
 gnss::WeightModel receiver_weight_model(const GnssOptions& options);
 
 /// Simulate rover and base observations from t_begin to t_end (GPST, epochs on the rate grid) for the given

@@ -114,6 +114,21 @@ TEST(Measurement, ElevationWeightScalesOnlyTheElevationPart) {
   EXPECT_NEAR(near_one, measurement_sigma(m, 40.0, 12.0 * kDegToRad, false), 1e-5);
 }
 
+// Eq. W2: the squaring loss b scales the code variance by (1 + b c²)/(1 + b): none at and above cn0_ref, and at
+// 20 dB below it (c² = 100) with b = 0.01 the variance is 2/1.01 of W1's; the Doppler is not touched.
+TEST(Measurement, SquaringLossGrowsTheCodeSigmaOnlyBelowTheReference) {
+  WeightModel m;
+  m.elevation_weight = 0.0;
+  const double w1_weak = measurement_sigma(m, 25.0, kPi / 2, false), w1_dopp = measurement_sigma(m, 25.0, kPi / 2, true);
+  m.code_squaring_loss = 0.01;
+  EXPECT_NEAR(measurement_sigma(m, 45.0, kPi / 2, false), m.code_sigma_zenith_m, 1e-12);
+  EXPECT_NEAR(measurement_sigma(m, 50.0, kPi / 2, false), m.code_sigma_zenith_m, 1e-12);
+  EXPECT_NEAR(measurement_sigma(m, 25.0, kPi / 2, false), w1_weak * std::sqrt(2.0 / 1.01), 1e-12);
+  EXPECT_NEAR(measurement_sigma(m, 25.0, kPi / 2, true), w1_dopp, 1e-15);
+  m.elevation_weight = 1.0;  // the closed-form k = 1 branch carries it too
+  EXPECT_NEAR(measurement_sigma(m, 25.0, 30.0 * kDegToRad, false), 2.0 * w1_weak * std::sqrt(2.0 / 1.01), 1e-12);
+}
+
 TEST(Measurement, ChiSquareQuantiles) {
   EXPECT_NEAR(chi_square_quantile(0.999, 1), 10.828, 1e-3);
   EXPECT_NEAR(chi_square_quantile(0.95, 5), 11.070, 1e-3);

@@ -207,6 +207,17 @@ TEST(Config, ElevationWeightKeyReachesTheEngineOptionsAndRoundTrips) {
   auto bad = parse(files + "gnss: {elevation_weight: 1.5}\n");
   ASSERT_FALSE(bad);
   EXPECT_THAT(bad.error().message, HasSubstr("gnss.elevation_weight"));
+  // gnss.code_squaring_loss (eq. W2) the same way.
+  EXPECT_DOUBLE_EQ(engine_options(*def).weights.code_squaring_loss, 0.0);
+  auto sq = parse(files + "gnss: {code_squaring_loss: 0.002}\n");
+  ASSERT_TRUE(sq) << sq.error().message;
+  EXPECT_DOUBLE_EQ(engine_options(*sq).weights.code_squaring_loss, 0.002);
+  auto sq2 = parse(to_yaml(*sq));
+  ASSERT_TRUE(sq2) << sq2.error().message;
+  EXPECT_DOUBLE_EQ(sq2->gnss.code_squaring_loss, 0.002);
+  auto bad_sq = parse(files + "gnss: {code_squaring_loss: -1}\n");
+  ASSERT_FALSE(bad_sq);
+  EXPECT_THAT(bad_sq.error().message, HasSubstr("gnss.code_squaring_loss"));
 }
 
 TEST(Config, ScaleBiasCompensationKeyReachesTheEngineOptionsAndRoundTrips) {
