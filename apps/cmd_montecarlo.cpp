@@ -59,6 +59,7 @@ struct McOptions {
   bool foot_antenna_velocity = false;  ///< Doppler rows with the foot's own velocity (`antenna: {velocity_model: foot}`)
   std::optional<bool> scale_bias_compensation;  ///< scale_factors.bias_compensation (unset: the default)
   double elevation_weight = std::numeric_limits<double>::quiet_NaN();  ///< gnss.elevation_weight (NaN: the default)
+  bool scenario_lever_arm = false;  ///< antenna lever arm from the scenario's walker geometry (docs/fusion.md §14)
   bool receiver_weights = false;   ///< code/Doppler weights from the scenario's receiver model (docs/consistency.md §3.8)
 };
 
@@ -133,6 +134,10 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
     c.gnss.doppler_sigma_zenith_mps = w.doppler_sigma_zenith_mps;
     c.gnss.elevation_weight = w.elevation_weight;
     c.gnss.code_squaring_loss = w.code_squaring_loss;
+  }
+  if (mo.scenario_lever_arm) {  // what a user measures on the walker: antenna height over the foot, foot beside the line
+    c.antenna.lever_arm_ned_m = Eigen::Vector3d(0.0, 0.0, -(sc.gnss.antenna_height_m - sc.gait.imu_height_m));
+    c.antenna.lever_arm_heading_m = Eigen::Vector3d(0.0, -sc.gait.foot_offset_m, 0.0);
   }
   if (!std::isnan(mo.elevation_weight)) c.gnss.elevation_weight = mo.elevation_weight;
   if (mo.scale_bias_compensation) c.scale_factors.bias_compensation = *mo.scale_bias_compensation;
@@ -462,6 +467,10 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
   cmd->add_flag("--receiver-weights", mo->receiver_weights,
                 "Code/Doppler weights from the scenario's receiver model (DLL thermal noise at its zenith C/N0, no "
                 "elevation factor unless --elevation-weight; docs/consistency.md §3.8) instead of pednav run's defaults");
+  cmd->add_flag("--scenario-lever-arm", mo->scenario_lever_arm,
+                "Antenna lever arm from the scenario's walker: antenna height above the foot IMU (NED) and the IMU foot "
+                "beside the walking line (antenna.lever_arm_heading_m = [0, -gait.foot_offset_m, 0]; docs/fusion.md §14) "
+                "instead of pednav run's default [0, 0, -1.2] m");
   cmd->add_option("--scale-bias-compensation", mo->scale_bias_compensation,
                   "true/false: subtract the errors-in-variables bias of the scale-factor updates "
                   "(scale_factors.bias_compensation, default true; docs/consistency.md §3.6-3.7)");

@@ -2,6 +2,7 @@
 
 #include "fusion/health.hpp"
 #include "fusion/kalman.hpp"
+#include "fusion/lever_arm.hpp"
 #include "fusion/rts.hpp"
 #include "fusion/stride_velocity.hpp"
 
@@ -1039,7 +1040,13 @@ class Runner {
     const int n = f.layout().dim();
     const double lag_s = t_proc - re.time;  // the state is at t_proc; move the antenna back to the epoch
     const Vector3d p_imu = f.x().nav.p_eb_e - f.x().nav.v_eb_e * lag_s;
-    const Vector3d p_a = p_imu + lever_e(p_imu);
+    // Eq. 14.1: the level-frame arm plus the part fixed in the foot's heading frame, whose heading error enters the
+    // code rows through eq. 14.2 (the arm's rotation rate is left out of the Doppler rows: 0.1 m × the yaw rate).
+    const Geodetic llh_imu = geodetic_from_ecef(p_imu);
+    const LeverArm arm = lever_arm_e(o_.lever_arm_n_m, o_.lever_arm_heading_m, R_e_n(llh_imu.lat, llh_imu.lon),
+                                     f.x().nav.R_e_b());
+    const bool arm_rotates = !o_.lever_arm_heading_m.isZero();
+    const Vector3d p_a = p_imu + arm.arm_e;
     // Antenna (body) velocity: the foot's stride-average velocity (eq. 13.1) or, with the kFoot model or before a
     // cycle of history exists, the foot's own velocity.
     std::optional<Vector3d> v_stride;
@@ -1102,6 +1109,7 @@ class Runner {
       rc.sigma = sigma_c;
       rc.h = ins::ErrorRowVector::Zero(n);
       rc.h.segment<3>(ins::kPos.offset) = code.J_p;
+      if (arm_rotates) rc.h.segment<3>(ins::kAtt.offset) = code.J_p * arm.d_arm_d_phi_e;  // eq. 14.2
       rc.j_antenna = code.J_p;
       rc.h(f.clock_offset(slot)) = code.J_clock;
       if (f.has_multipath()) {

@@ -61,6 +61,9 @@ struct EngineOptions {
   gnss::WeightModel weights;
   bool use_doppler = true;
   Eigen::Vector3d lever_arm_n_m{0.0, 0.0, -1.2};  ///< IMU -> antenna, local level NED [m] (foot -> backpack)
+  /// IMU -> antenna part fixed in the foot's heading frame (forward, right, down) [m], added to lever_arm_n_m in the
+  /// GNSS rows (docs/fusion.md §14, eq. 14.1): a right-foot IMU has the body about half a step width to its left.
+  Eigen::Vector3d lever_arm_heading_m = Eigen::Vector3d::Zero();
   double antenna_sigma_horizontal_m = 0.4;   ///< non-rigid arm: antenna offset noise (white) [m]
   double antenna_sigma_vertical_m = 0.2;
   double antenna_velocity_sigma_horizontal_mps = 1.0;  ///< foot vs body velocity at the GNSS epoch [m/s]

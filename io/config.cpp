@@ -128,7 +128,9 @@ std::string to_yaml(const RunConfig& c) {
   }
   e << YAML::Key << "antenna" << YAML::Value << YAML::BeginMap << YAML::Key << "lever_arm_ned_m" << YAML::Value
     << YAML::Flow << YAML::BeginSeq << c.antenna.lever_arm_ned_m.x() << c.antenna.lever_arm_ned_m.y()
-    << c.antenna.lever_arm_ned_m.z() << YAML::EndSeq << YAML::Key << "sigma_horizontal_m" << YAML::Value
+    << c.antenna.lever_arm_ned_m.z() << YAML::EndSeq << YAML::Key << "lever_arm_heading_m" << YAML::Value << YAML::Flow
+    << YAML::BeginSeq << c.antenna.lever_arm_heading_m.x() << c.antenna.lever_arm_heading_m.y()
+    << c.antenna.lever_arm_heading_m.z() << YAML::EndSeq << YAML::Key << "sigma_horizontal_m" << YAML::Value
     << c.antenna.sigma_horizontal_m << YAML::Key << "sigma_vertical_m" << YAML::Value << c.antenna.sigma_vertical_m
     << YAML::Key << "velocity_model" << YAML::Value << c.antenna.velocity_model << YAML::Key
     << "velocity_sigma_horizontal_mps" << YAML::Value << c.antenna.velocity_sigma_horizontal_mps << YAML::Key

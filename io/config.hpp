@@ -112,6 +112,8 @@ struct InitialConfig {
 /// `antenna:` section: IMU (foot) -> antenna (backpack) geometry of the tightly coupled filter.
 struct AntennaConfig {
   Eigen::Vector3d lever_arm_ned_m{0.0, 0.0, -1.2};
+  /// part fixed in the foot's heading frame (forward, right, down) [m] (docs/fusion.md §14; right foot: [0, -0.1, 0])
+  Eigen::Vector3d lever_arm_heading_m = Eigen::Vector3d::Zero();
   double sigma_horizontal_m = 0.4;
   double sigma_vertical_m = 0.2;
   double velocity_sigma_horizontal_mps = 1.0;

@@ -67,6 +67,7 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
     YamlMap a = top.map("antenna");
     AntennaConfig& c = out.antenna;
     a.vector3("lever_arm_ned_m", c.lever_arm_ned_m);
+    a.vector3("lever_arm_heading_m", c.lever_arm_heading_m);
     a.number("sigma_horizontal_m", c.sigma_horizontal_m, false, 0.0, 100.0);
     a.number("sigma_vertical_m", c.sigma_vertical_m, false, 0.0, 100.0);
     a.number("velocity_sigma_horizontal_mps", c.velocity_sigma_horizontal_mps, false, 0.0, 100.0);

@@ -122,6 +122,7 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.use_doppler = c.gnss.use_doppler;
   o.max_base_age_s = c.gnss.max_base_age_s;
   o.lever_arm_n_m = c.antenna.lever_arm_ned_m;
+  o.lever_arm_heading_m = c.antenna.lever_arm_heading_m;
   o.antenna_sigma_horizontal_m = c.antenna.sigma_horizontal_m;
   o.antenna_sigma_vertical_m = c.antenna.sigma_vertical_m;
   o.antenna_velocity_sigma_horizontal_mps = c.antenna.velocity_sigma_horizontal_mps;

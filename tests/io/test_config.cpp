@@ -261,6 +261,26 @@ TEST(Config, AntennaVelocityModelKeysAndResolvedRoundTrip) {
   EXPECT_THAT(zero.error().message, HasSubstr("antenna.stride_velocity_sigma_horizontal_mps"));
 }
 
+// antenna.lever_arm_heading_m (docs/fusion.md §14): read, reaches the engine, round-trips; default zero; a
+// two-element list names the key.
+TEST(Config, HeadingFrameLeverArmKeyReachesTheEngineAndRoundTrips) {
+  const std::string files = "mode: gnss\nrover_obs: r.obs\nnav: n.nav\n";
+  auto def = parse(files);
+  ASSERT_TRUE(def) << def.error().message;
+  EXPECT_TRUE(engine_options(*def).lever_arm_heading_m.isZero());
+  auto cfg = parse(files + "antenna: {lever_arm_heading_m: [0.05, -0.1, 0.02]}\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_DOUBLE_EQ(engine_options(*cfg).lever_arm_heading_m.y(), -0.1);
+  auto again = parse(to_yaml(*cfg));
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_DOUBLE_EQ(again->antenna.lever_arm_heading_m.x(), 0.05);
+  EXPECT_DOUBLE_EQ(again->antenna.lever_arm_heading_m.y(), -0.1);
+  EXPECT_DOUBLE_EQ(again->antenna.lever_arm_heading_m.z(), 0.02);
+  auto bad = parse(files + "antenna: {lever_arm_heading_m: [0, -0.1]}\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("antenna.lever_arm_heading_m"));
+}
+
 TEST(Config, MultipathAndScaleFactorStateKeys) {
   auto cfg = parse(
       "mode: gnss\nrover_obs: r.obs\nnav: n.nav\nmultipath:\n  states: true\n  sigma_m: 0.5\n  tau_s: 30\n"
