@@ -1041,7 +1041,8 @@ class Runner {
     const double lag_s = t_proc - re.time;  // the state is at t_proc; move the antenna back to the epoch
     const Vector3d p_imu = f.x().nav.p_eb_e - f.x().nav.v_eb_e * lag_s;
     // Eq. 14.1: the level-frame arm plus the part fixed in the foot's heading frame, whose heading error enters the
-    // code rows through eq. 14.2 (the arm's rotation rate is left out of the Doppler rows: 0.1 m × the yaw rate).
+    // code rows through eq. 14.2 (the arm's rotation rate is left out of the Doppler rows: 0.1 m × the foot's yaw
+    // rate, inside the stride-velocity σ).
     const Geodetic llh_imu = geodetic_from_ecef(p_imu);
     const LeverArm arm = lever_arm_e(o_.lever_arm_n_m, o_.lever_arm_heading_m, R_e_n(llh_imu.lat, llh_imu.lon),
                                      f.x().nav.R_e_b());

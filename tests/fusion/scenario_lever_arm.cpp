@@ -51,7 +51,8 @@ TEST(HeadingLeverArm, SmoothedStaticStartHasNoCrossTrackBiasOnlyWithTheArm) {
   for (int on = 0; on < 2; ++on) {
     fusion::EngineOptions o = test::tc_default_options(file, *s);
     o.smoother_enabled = true;
-    o.lever_arm_n_m = Eigen::Vector3d(0.0, 0.0, -(file.scenario.gnss.antenna_height_m - file.scenario.gait.imu_height_m));
+    o.lever_arm_n_m =
+        Eigen::Vector3d(0.0, 0.0, -(file.scenario.gnss.antenna_height_m - file.scenario.gait.imu_height_m));
     if (on == 1) o.lever_arm_heading_m = Eigen::Vector3d(0.0, -kOffset_m, 0.0);
     auto r = fusion::run_forward(test::engine_inputs(*s), o);
     ASSERT_TRUE(r.has_value()) << r.error().message;

@@ -1,14 +1,13 @@
 // The foot-IMU -> antenna lever arm with a part fixed in the foot's heading frame (fusion/lever_arm.hpp,
 // docs/fusion.md §14): its value at known headings, and its attitude Jacobian (eq. 14.2) against numerical
 // differentiation through the error-state attitude perturbation, for level and strongly pitched feet.
-#include "fusion/lever_arm.hpp"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 
 #include "core/geodesy.hpp"
+#include "fusion/lever_arm.hpp"
 
 namespace pednav::fusion {
 namespace {
@@ -53,12 +52,12 @@ TEST(LeverArm, AttitudeJacobianMatchesNumericalDifferentiation) {
         // True attitude = exp([φ×]) R_e_b (docs/error_state.md).
         const Eigen::Matrix3d plus = Eigen::AngleAxisd(kStep, phi.normalized()).toRotationMatrix() * Reb;
         const Eigen::Matrix3d minus = Eigen::AngleAxisd(-kStep, phi.normalized()).toRotationMatrix() * Reb;
-        J.col(k) = (lever_arm_e(arm_n, arm_h, Ren, plus).arm_e - lever_arm_e(arm_n, arm_h, Ren, minus).arm_e) /
-                   (2.0 * kStep);
+        J.col(k) =
+            (lever_arm_e(arm_n, arm_h, Ren, plus).arm_e - lever_arm_e(arm_n, arm_h, Ren, minus).arm_e) / (2.0 * kStep);
       }
       EXPECT_LT((J - a.d_arm_d_phi_e).cwiseAbs().maxCoeff(), 1e-8) << "yaw " << yaw << " pitch " << pitch << "\n"
-                                                                    << J << "\n"
-                                                                    << a.d_arm_d_phi_e;
+                                                                   << J << "\n"
+                                                                   << a.d_arm_d_phi_e;
       EXPECT_GT(a.d_arm_d_phi_e.norm(), 0.05);  // the arm does rotate: the comparison is not 0 = 0
       ++checked;
     }
