@@ -1046,7 +1046,6 @@ class Runner {
     const Geodetic llh_imu = geodetic_from_ecef(p_imu);
     const LeverArm arm = lever_arm_e(o_.lever_arm_n_m, o_.lever_arm_heading_m, R_e_n(llh_imu.lat, llh_imu.lon),
                                      f.x().nav.R_e_b());
-    const bool arm_rotates = !o_.lever_arm_heading_m.isZero();
     const Vector3d p_a = p_imu + arm.arm_e;
     // Antenna (body) velocity: the foot's stride-average velocity (eq. 13.1) or, with the kFoot model or before a
     // cycle of history exists, the foot's own velocity.
@@ -1110,7 +1109,7 @@ class Runner {
       rc.sigma = sigma_c;
       rc.h = ins::ErrorRowVector::Zero(n);
       rc.h.segment<3>(ins::kPos.offset) = code.J_p;
-      if (arm_rotates) rc.h.segment<3>(ins::kAtt.offset) = code.J_p * arm.d_arm_d_phi_e;  // eq. 14.2
+      rc.h.segment<3>(ins::kAtt.offset) = code.J_p * arm.d_arm_d_phi_e;  // eq. 14.2 (zero without a heading part)
       rc.j_antenna = code.J_p;
       rc.h(f.clock_offset(slot)) = code.J_clock;
       if (f.has_multipath()) {
