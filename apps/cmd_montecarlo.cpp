@@ -60,6 +60,7 @@ struct McOptions {
   std::optional<bool> scale_bias_compensation;  ///< scale_factors.bias_compensation (unset: the default)
   double elevation_weight = std::numeric_limits<double>::quiet_NaN();  ///< gnss.elevation_weight (NaN: the default)
   bool scenario_lever_arm = false;  ///< antenna lever arm from the scenario's walker geometry (docs/fusion.md §14)
+  bool g_sensitivity_states = false;  ///< filter g-sensitivity states with the scenario's σ (docs/error_state.md §5)
   bool receiver_weights = false;   ///< code/Doppler weights from the scenario's receiver model (docs/consistency.md §3.8)
 };
 
@@ -135,6 +136,8 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
     c.gnss.elevation_weight = w.elevation_weight;
     c.gnss.code_squaring_loss = w.code_squaring_loss;
   }
+  // The gyro's g-sensitivity σ as a data sheet states it = the simulated one: the filter gets its 9 G states.
+  if (mo.g_sensitivity_states) c.imu.spec.gyro_g_sensitivity = sc.imu.gyro_g_sensitivity_sigma;
   if (mo.scenario_lever_arm) {  // what a user measures on the walker: antenna height over the foot, foot beside the line
     c.antenna.lever_arm_ned_m = Eigen::Vector3d(0.0, 0.0, -(sc.gnss.antenna_height_m - sc.gait.imu_height_m));
     c.antenna.lever_arm_heading_m = Eigen::Vector3d(0.0, -sc.gait.foot_offset_m, 0.0);
@@ -394,17 +397,20 @@ int run_montecarlo(const McOptions& mo) {
   j["runs_done_now"] = todo.size();
   j["jobs"] = jobs;
   j["nees_in_band_fraction_forward"] = sf.nees_in_band_fraction;
-  j["nees_in_band_fraction_smoothed"] = ss.nees_in_band_fraction;
+  // No smoothed epochs (--no-smoother, or consider states, which the backward pass does not support): null, not 0.
+  const bool have_smoothed = ss.epochs > 0;
+  auto smoothed_value = [&](double v) { return have_smoothed ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  j["nees_in_band_fraction_smoothed"] = smoothed_value(ss.nees_in_band_fraction);
   j["sigma_ratio_horizontal"] = sf.sigma_ratio_horizontal;
   j["sigma_ratio_yaw"] = sf.sigma_ratio_yaw;
-  j["sigma_ratio_horizontal_smoothed"] = ss.sigma_ratio_horizontal;
-  j["sigma_ratio_yaw_smoothed"] = ss.sigma_ratio_yaw;
+  j["sigma_ratio_horizontal_smoothed"] = smoothed_value(ss.sigma_ratio_horizontal);
+  j["sigma_ratio_yaw_smoothed"] = smoothed_value(ss.sigma_ratio_yaw);
   j["wall_s"] = wall;
   j["run_wall_s_sum"] = run_wall_sum;
   j["nees_band_probability"] = 0.95;
   j["min_runs_per_epoch"] = min_runs;
   j["forward"] = summary_json(sf);
-  j["smoothed"] = summary_json(ss);
+  j["smoothed"] = have_smoothed ? summary_json(ss) : nlohmann::json(nullptr);
   for (const auto& [name, text] : {std::pair<std::string, std::string>{"runs.csv", rc.str()},
                                    {"nees.csv", nc.str()},
                                    {"summary.json", j.dump(2) + "\n"}}) {
@@ -413,12 +419,15 @@ int run_montecarlo(const McOptions& mo) {
       return 1;
     }
   }
+  const std::string smoothed_text =
+      have_smoothed ? fmt::format("NEES in band {:.1f} %, sigma ratio horizontal {:.3f} yaw {:.3f}, RMS {:.2f} m",
+                                  100.0 * ss.nees_in_band_fraction, ss.sigma_ratio_horizontal, ss.sigma_ratio_yaw,
+                                  ss.rms_horizontal_m)
+                    : std::string("none");
   spdlog::info("montecarlo: {} runs ({} failed) in {:.1f} s on {} threads; forward: NEES in band {:.1f} % of {} "
-               "epochs, sigma ratio horizontal {:.3f} yaw {:.3f}, RMS {:.2f} m; smoothed: NEES in band {:.1f} %, "
-               "sigma ratio horizontal {:.3f} yaw {:.3f}, RMS {:.2f} m -> {}",
+               "epochs, sigma ratio horizontal {:.3f} yaw {:.3f}, RMS {:.2f} m; smoothed: {} -> {}",
                n_ok, mo.runs - n_ok, wall, jobs, 100.0 * sf.nees_in_band_fraction, sf.epochs,
-               sf.sigma_ratio_horizontal, sf.sigma_ratio_yaw, sf.rms_horizontal_m, 100.0 * ss.nees_in_band_fraction,
-               ss.sigma_ratio_horizontal, ss.sigma_ratio_yaw, ss.rms_horizontal_m, mo.out_dir);
+               sf.sigma_ratio_horizontal, sf.sigma_ratio_yaw, sf.rms_horizontal_m, smoothed_text, mo.out_dir);
   return 0;
 }
 
@@ -471,6 +480,9 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
                 "Antenna lever arm from the scenario's walker: antenna height above the foot IMU (NED) and the IMU foot "
                 "beside the walking line (antenna.lever_arm_heading_m = [0, -gait.foot_offset_m, 0]; docs/fusion.md §14) "
                 "instead of pednav run's default [0, 0, -1.2] m");
+  cmd->add_flag("--g-sensitivity-states", mo->g_sensitivity_states,
+                "Filter states for the gyro's g-sensitivity matrix (9, random constants) with the scenario's σ "
+                "(imu.spec gyro_g_sensitivity_deg_per_s_per_g; docs/error_state.md §5)");
   cmd->add_option("--scale-bias-compensation", mo->scale_bias_compensation,
                   "true/false: subtract the errors-in-variables bias of the scale-factor updates "
                   "(scale_factors.bias_compensation, default true; docs/consistency.md §3.6-3.7)");

@@ -149,6 +149,17 @@ class Filter {
         mp_last_ns_.assign(o.multipath_slots, kNeverNs);
       }
     }
+    // The g-sensitive gyro error (docs/error_state.md §5) when the spec gives its σ; after the GNSS blocks, so that
+    // the errors-in-variables footprints of tc (kept on the leading INS block) do not carry it.
+    if (spec_.gyro_g_sensitivity > 0.0) {
+      auto b = layout_.add(ins::kGSensitivityBlock, 9);
+      if (!b) {
+        problem_ = b.error().message;
+        return;
+      }
+      g_sens_offset_ = b->offset;
+      consider_ = ConsiderStates{b->offset, 9};
+    }
     if (o.scale_bias_compensation) {  // docs/consistency.md §3.6
       for (const char* name : {ins::kScaleGyroBlock, ins::kScaleAccBlock}) {
         const auto b = layout_.find(name);
@@ -268,7 +279,7 @@ class Filter {
       int nz[ins::kMaxErrorDim];
       const int n_nz = nonzero_columns(H, nz);
       for (size_t j = 0; j < eiv_.size(); ++j) eiv_bias[j] = eiv_update(eiv_[j].M, H, nz, n_nz, S_ldlt, K);
-    });
+    }, consider_);
     if (!ok) return false;
     for (size_t j = 0; j < eiv_.size(); ++j) {
       dx(eiv_[j].state) -= eiv_bias[j];
@@ -319,6 +330,10 @@ class Filter {
     reset = true;
     return lru;
   }
+  /// Whether some states are consider states (never corrected; Schmidt–Kalman).
+  bool has_consider_states() const { return consider_.count > 0; }
+  /// First state of the g-sensitivity block (column-major G_g), −1 without it.
+  int g_sensitivity_offset() const { return g_sens_offset_; }
   /// State index of multipath slot `slot`; its nominal value u (closed loop: normally 0 after each update, decayed).
   int multipath_index(int slot) const { return mp_block_.offset + slot; }
   double multipath_value(int slot) const { return mp_value_[slot]; }
@@ -424,6 +439,10 @@ class Filter {
       e.sd.s_a = sd(b->offset);
       for (int i = 0; i < 3; ++i) e.accel_scale_compensation(i) = eiv_correction(b->offset + i);
     }
+    if (const auto b = layout_.find(ins::kGSensitivityBlock)) {
+      e.g_sensitivity = true;
+      for (int k = 0; k < 9; ++k) e.sd.G_g(k % 3, k / 3) = std::sqrt(P_(b->offset + k, b->offset + k));
+    }
     return e;
   }
 
@@ -462,6 +481,8 @@ class Filter {
   // Code multipath Gauss-Markov states (docs/consistency.md §3): block, nominal values, satellite and last epoch.
   static constexpr int64_t kNeverNs = std::numeric_limits<int64_t>::min();
   ins::Block mp_block_{0, 0};
+  int g_sens_offset_ = -1;  // g-sensitivity block (docs/error_state.md §5), −1 without it
+  ConsiderStates consider_;  // states the updates never correct (Schmidt–Kalman): the g-sensitivity unless estimated
   std::vector<double> mp_value_;
   std::vector<gnss::SatId> mp_sat_;
   std::vector<int64_t> mp_last_ns_;
@@ -642,7 +663,14 @@ class Runner {
     }
     // Smoother (docs/fusion.md §12): one backward record per output epoch, carried forward from each output epoch
     // to the next by the filter (eqs. 12.14-12.20).
-    const bool smooth = o_.smoother_enabled;
+    // Consider states (the g-sensitivity, docs/error_state.md §5) leave the forward error with a non-zero conditional
+    // mean and correlated innovations, which the backward pass assumes away: no smoothing with them.
+    const bool smooth = o_.smoother_enabled && !f.has_consider_states();
+    if (o_.smoother_enabled && !smooth) {
+      sum.smoother_message =
+          "not smoothed: the gyro g-sensitivity states are consider states (Schmidt-Kalman), which the RTS pass does "
+          "not support (docs/error_state.md §5)";
+    }
     const int n_state = f.layout().dim();
     RtsSegment segment;
     RtsStore segments(n_state);
@@ -971,6 +999,12 @@ class Runner {
       const Vector3d omega_ie_b = f.x().nav.R_e_b().transpose() * Vector3d(0, 0, wgs84::kOmegaIE_radps);
       r.tail<3>() = inc.alpha_b / inc.dt_s - omega_ie_b;  // = true - estimated bias if the foot is still
       H.block<3, 3>(3, ins::kBiasGyro.offset).setIdentity();
+      // The g-sensitive part δG_g f of the corrected rate (docs/error_state.md eq. 5.3): without it the ZARU would
+      // tell the bias apart from G_g f at rest, and the tilt drift the ZUPTs see would then "observe" G_g.
+      if (const int g = f.g_sensitivity_offset(); g >= 0) {
+        const Vector3d f_b = inc.upsilon_b / inc.dt_s;
+        for (int j = 0; j < 3; ++j) H.block<3, 3>(3, g + 3 * j).diagonal().setConstant(f_b(j));
+      }
       const double var = o_.zaru_sigma_radps * o_.zaru_sigma_radps / std::max(1, inc.samples);
       R.bottomRightCorner<3, 3>().diagonal().setConstant(var);
     }

@@ -153,6 +153,7 @@ struct ImuEstimate {
   Eigen::Vector3d accel_scale_compensation = Eigen::Vector3d::Zero();
   bool gyro_scale = false;   ///< the gyro scale block was estimated
   bool accel_scale = false;  ///< the accelerometer scale block was estimated
+  bool g_sensitivity = false;  ///< the gyro g-sensitivity consider block is in the state (sd.G_g elementwise)
 };
 
 /// Counts for summary.json: every input accounted for.

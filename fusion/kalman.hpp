@@ -78,9 +78,16 @@ inline void gain_downdate(ins::ErrorMatrix& X, const MatU& U, const MatK& K, con
 /// untouched) if H P Hᵀ + R is not positive definite. With fixed-capacity H, r and R nothing is allocated.
 /// on_gain(ldlt, K) is called with the factorization of H P Hᵀ + R and the gain before P changes (the smoother's
 /// bookkeeping, fusion::RtsInterval::update).
+/// Consider states (Schmidt–Kalman, docs/error_state.md §5): the rows [consider.begin, consider.begin + count) of K
+/// are set to zero — those states are never corrected, but their uncertainty stays in P and reaches the others
+/// through Φ; the expanded Joseph form below is exact for that gain.
+struct ConsiderStates {
+  int begin = 0;
+  int count = 0;
+};
 template <typename MatH, typename VecR, typename MatR, typename OnGain>
 bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR& R, ins::ErrorVector& dx,
-                   OnGain&& on_gain) {
+                   OnGain&& on_gain, ConsiderStates consider = {}) {
   using ColsMatrix = Eigen::Matrix<double, Eigen::Dynamic, MatH::RowsAtCompileTime, Eigen::ColMajor,
                                    ins::kMaxErrorDim, MatH::MaxRowsAtCompileTime>;
   using SMatrix = Eigen::Matrix<double, MatH::RowsAtCompileTime, MatH::RowsAtCompileTime, Eigen::ColMajor,
@@ -100,7 +107,8 @@ bool joseph_update(ins::ErrorMatrix& P, const MatH& H, const VecR& r, const MatR
   const Eigen::LDLT<SMatrix> ldlt(S);
   // Eigen's LDLT reports success for indefinite matrices too: positive definite means every pivot D_ii > 0.
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 0.0).all()) return false;
-  const ColsMatrix K = ldlt.solve(PHt.transpose()).transpose();
+  ColsMatrix K = ldlt.solve(PHt.transpose()).transpose();
+  if (consider.count > 0) K.middleRows(consider.begin, consider.count).setZero();
   dx.noalias() = K * r;
   on_gain(ldlt, K);
   // Joseph form, expanded (exact for any gain K, so a rounding error in K still enters P only to second order):

@@ -56,6 +56,7 @@ InsState boxplus(const InsState& x, const Eigen::Ref<const Eigen::VectorXd>& dx,
   y.imu.b_a += dx.segment<3>(kBiasAcc.offset);
   if (auto b = layout.find(kScaleGyroBlock)) y.imu.s_g += dx.segment<3>(b->offset);
   if (auto b = layout.find(kScaleAccBlock)) y.imu.s_a += dx.segment<3>(b->offset);
+  if (auto b = layout.find(kGSensitivityBlock)) y.imu.G_g += dx.segment<9>(b->offset).reshaped(3, 3);
   return y;
 }
 
@@ -68,13 +69,14 @@ Eigen::VectorXd boxminus(const InsState& a, const InsState& b, const ErrorStateL
   dx.segment<3>(kBiasAcc.offset) = a.imu.b_a - b.imu.b_a;
   if (auto s = layout.find(kScaleGyroBlock)) dx.segment<3>(s->offset) = a.imu.s_g - b.imu.s_g;
   if (auto s = layout.find(kScaleAccBlock)) dx.segment<3>(s->offset) = a.imu.s_a - b.imu.s_a;
+  if (auto s = layout.find(kGSensitivityBlock)) dx.segment<9>(s->offset) = (a.imu.G_g - b.imu.G_g).reshaped();
   return dx;
 }
 
 // docs/error_state.md eq. (3.1)-(3.8):
 //   δṗ = δv
 //   δv̇ = Γ δp - 2[ω_ie×] δv - [f_e×] φ - R δb_a - R diag(f_b) δs_a - R n_a
-//   φ̇  = -[ω_ie×] φ - R δb_g - R diag(ω_b) δs_g - R n_g
+//   φ̇  = -[ω_ie×] φ - R δb_g - R diag(ω_b) δs_g - R δG_g f_b - R n_g   (δG_g f_b = Σ_j f_b,j δG_g[:, j], §6)
 //   δḃ = -δb/τ + w_b  (τ <= 0: random walk),   δṡ = -δs/τ_s + w_s
 ContinuousErrorModel continuous_error_model(const ErrorStateLayout& layout, const ImuSpec& spec,
                                             const Eigen::Matrix3d& R_e_b, const Eigen::Vector3d& p_eb_e,
@@ -130,6 +132,9 @@ ContinuousErrorModel continuous_error_model(const ErrorStateLayout& layout, cons
     blk(m.G, s, ws) = I;
     blk(m.Q, ws, ws) = psd_gm(spec.accel_scale_sigma, spec.scale_tau_s) * I;
   }
+  if (const auto gs = layout.find(kGSensitivityBlock)) {  // random constants: no dynamics, no noise
+    for (int j = 0; j < 3; ++j) m.F.block(kAtt.offset, gs->offset + 3 * j, 3, 3) = -R_e_b * f_ib_b(j);
+  }
   return m;
 }
 
@@ -171,10 +176,10 @@ DiscreteErrorModel discretize(const ContinuousErrorModel& model, double dt_s, Qd
 
 namespace {
 
-// The INS error model of eq. (3.1)-(3.8) as a matrix of 3x3 blocks (at most 7 x 7: pos, vel, att, gyro bias,
-// accel bias, gyro scale, accel scale) with a flag per nonzero block: Φ and Q_d of the series method are
-// products of a few 3x3 blocks (docs/error_state.md §5, docs/performance.md §1), not of n x n matrices.
-constexpr int kMaxInsBlocks = 7;
+// The INS error model of eq. (3.1)-(3.8) as a matrix of 3x3 blocks (at most 10 x 10: pos, vel, att, gyro bias,
+// accel bias, gyro scale, accel scale, the three columns of G_g) with a flag per nonzero block: Φ and Q_d of the series method are
+// products of a few 3x3 blocks (docs/error_state.md §4, docs/performance.md §1), not of n x n matrices.
+constexpr int kMaxInsBlocks = 10;
 struct Blocks3 {
   std::array<int, kMaxInsBlocks> offset{};
   int count = 0;
@@ -274,7 +279,7 @@ void interval_error_model(const ErrorStateLayout& layout, const ImuSpec& spec, c
   Blocks3 F;
   std::array<double, kMaxInsBlocks> S{};  // S_kk = S[k] I
   F.count = 5;
-  F.offset = {kPos.offset, kVel.offset, kAtt.offset, kBiasGyro.offset, kBiasAcc.offset, 0, 0};
+  F.offset = {kPos.offset, kVel.offset, kAtt.offset, kBiasGyro.offset, kBiasAcc.offset, 0, 0, 0, 0, 0};
   F.set(P, V, I);
   F.set(V, P, gravity_gradient_ecef(p_mid));
   F.set(V, V, -2.0 * W);
@@ -302,6 +307,14 @@ void interval_error_model(const ErrorStateLayout& layout, const ImuSpec& spec, c
     F.set(V, s, -R * f_b.asDiagonal());
     if (spec.scale_tau_s > 0.0) F.set(s, s, -I / spec.scale_tau_s);
     S[s] = psd_gm(spec.accel_scale_sigma, spec.scale_tau_s);
+  }
+  if (const auto gs = layout.find(kGSensitivityBlock)) {  // column j of G_g: φ̇ ∋ −R f_b,j δG_g[:, j] (§6)
+    for (int j = 0; j < 3; ++j) {
+      const int s = F.count++;
+      F.offset[s] = gs->offset + 3 * j;
+      F.set(A, s, -R * f_b(j));
+      S[s] = 0.0;
+    }
   }
   discretize_blocks(F, S, layout.dim(), dt, out);
 }
@@ -332,6 +345,10 @@ Eigen::MatrixXd initial_covariance(const ErrorStateLayout& layout, const ImuSpec
   set(kBiasAcc, Eigen::Vector3d::Constant(ba));
   if (auto b = layout.find(kScaleGyroBlock)) set(*b, Eigen::Vector3d::Constant(spec.gyro_scale_sigma));
   if (auto b = layout.find(kScaleAccBlock)) set(*b, Eigen::Vector3d::Constant(spec.accel_scale_sigma));
+  if (auto b = layout.find(kGSensitivityBlock)) {
+    const double v = spec.gyro_g_sensitivity * spec.gyro_g_sensitivity;
+    P.block(b->offset, b->offset, 9, 9) = v * Eigen::MatrixXd::Identity(9, 9);
+  }
   return P;
 }
 

@@ -18,7 +18,7 @@
 namespace pednav::ins {
 
 /// Largest error-state dimension (15 core + scale factors + clocks + ...): the capacity of the matrix types below.
-inline constexpr int kMaxErrorDim = 40;
+inline constexpr int kMaxErrorDim = 48;
 /// Error-state vector and matrix with a compile-time capacity of kMaxErrorDim: sized at run time, stored inline, so
 /// the per-epoch path never allocates on the heap (issue 10; docs/performance.md).
 using ErrorVector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxErrorDim, 1>;
@@ -35,6 +35,9 @@ inline constexpr int kCoreDim = 15;
 /// Names of the optional blocks the INS model itself understands (others are owned by their modules).
 inline constexpr const char* kScaleGyroBlock = "scale_gyro";
 inline constexpr const char* kScaleAccBlock = "scale_acc";
+/// The 9 elements of the g-sensitive gyro error matrix G_g, column-major (state 3j + i = G_g(i, j)), random
+/// constants (docs/error_state.md §5).
+inline constexpr const char* kGSensitivityBlock = "gsens_gyro";  // ≤ 15 characters: no heap allocation per lookup
 
 /// The error-state layout: the 15 core states at fixed offsets, then optional blocks registered at start-up
 /// (scale factors, clock, lever arm, ...) appended in registration order.
@@ -62,7 +65,7 @@ struct InsState {
   ImuErrors imu;
 };
 
-/// x ⊞ δx over the INS blocks (core + scale factors if registered); other blocks of δx are ignored.
+/// x ⊞ δx over the INS blocks (core + scale factors + g-sensitivity if registered); other blocks of δx are ignored.
 InsState boxplus(const InsState& x, const Eigen::Ref<const Eigen::VectorXd>& dx, const ErrorStateLayout& layout);
 /// δx = a ⊟ b such that a = b ⊞ δx (INS blocks; other blocks zero). φ = log(R_a R_b^T).
 Eigen::VectorXd boxminus(const InsState& a, const InsState& b, const ErrorStateLayout& layout);
@@ -80,7 +83,7 @@ ContinuousErrorModel continuous_error_model(const ErrorStateLayout& layout, cons
                                             const Eigen::Matrix3d& R_e_b, const Eigen::Vector3d& p_eb_e,
                                             const Eigen::Vector3d& f_ib_b, const Eigen::Vector3d& omega_ib_b);
 
-/// Discretization methods of Qd (docs/error_state.md §5).
+/// Discretization methods of Qd (docs/error_state.md §4).
 enum class QdMethod {
   kSeries,       ///< Qd = S Δt + (F S + S F^T) Δt²/2 + F S F^T Δt³/3, S = G Q G^T (default: Van Loan's integral
                  ///< to third order in Δt; cheap and gets the position-noise term S_vv Δt³/3 right)

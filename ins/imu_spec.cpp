@@ -113,6 +113,7 @@ std::vector<std::string> ImuSpec::problems() const {
   nonneg(accel_bias_initial, "accel_bias_initial");
   nonneg(gyro_scale_sigma, "gyro_scale_sigma");
   nonneg(accel_scale_sigma, "accel_scale_sigma");
+  nonneg(gyro_g_sensitivity, "gyro_g_sensitivity");
   nonneg(gyro_range, "gyro_range");
   nonneg(accel_range, "accel_range");
   if (gyro_bias_instability > 0.0 && !(gyro_bias_tau_s > 0.0))

@@ -23,21 +23,23 @@ Eigen::Vector3d remove(const Eigen::Vector3d& v, const Eigen::Vector3d& bias_tim
 
 ImuIncrement correct_increment(const ImuIncrement& inc, const ImuErrors& e) {
   ImuIncrement out = inc;
-  const Eigen::Vector3d bg_dt = e.b_g * inc.dt_s, ba_dt = e.b_a * inc.dt_s;
-  out.alpha_b = remove(inc.alpha_b, bg_dt, e.s_g);
-  out.dtheta_b = remove(inc.dtheta_b, bg_dt, e.s_g);
+  const Eigen::Vector3d ba_dt = e.b_a * inc.dt_s;
   out.upsilon_b = remove(inc.upsilon_b, ba_dt, e.s_a);
   out.dv_b = remove(inc.dv_b, ba_dt, e.s_a);
   out.dp_b = remove(inc.dp_b, 0.5 * inc.dt_s * ba_dt, e.s_a);
-  out.omega_end_b = remove(inc.omega_end_b, e.b_g, e.s_g);
   out.f_end_b = remove(inc.f_end_b, e.b_a, e.s_a);
+  // ∫ G f dt = G υ (corrected specific force): the g-sensitive part of the angle increment.
+  const Eigen::Vector3d bg_dt = e.b_g * inc.dt_s + e.G_g * out.upsilon_b;
+  out.alpha_b = remove(inc.alpha_b, bg_dt, e.s_g);
+  out.dtheta_b = remove(inc.dtheta_b, bg_dt, e.s_g);
+  out.omega_end_b = remove(inc.omega_end_b, e.b_g + e.G_g * out.f_end_b, e.s_g);
   return out;
 }
 
 ImuSample correct_sample(const ImuSample& s, const ImuErrors& e) {
   ImuSample out = s;
-  out.omega_ib_b = remove(s.omega_ib_b, e.b_g, e.s_g);
   out.f_ib_b = remove(s.f_ib_b, e.b_a, e.s_a);
+  out.omega_ib_b = remove(s.omega_ib_b, e.b_g + e.G_g * out.f_ib_b, e.s_g);
   return out;
 }
 

@@ -15,10 +15,13 @@ struct ImuErrors {
   Eigen::Vector3d b_a = Eigen::Vector3d::Zero();  ///< accelerometer bias [m/s^2], body frame
   Eigen::Vector3d s_g = Eigen::Vector3d::Zero();  ///< gyro scale-factor errors [-] (1e-6 = 1 ppm)
   Eigen::Vector3d s_a = Eigen::Vector3d::Zero();  ///< accelerometer scale-factor errors [-]
+  /// g-sensitive gyro error: ω_measured = (I + diag s_g) ω + b_g + G_g f [rad/s per m/s^2] (docs/error_state.md §5).
+  Eigen::Matrix3d G_g = Eigen::Matrix3d::Zero();
 };
 
-/// Remove estimated biases and scale factors from an increment (first order: the compensation terms are
-/// corrected with the same ratio as the plain increments).
+/// Remove estimated biases, scale factors and the g-sensitive gyro error (G_g times the corrected velocity
+/// increment) from an increment (first order: the compensation terms are corrected with the same ratio as the plain
+/// increments).
 ImuIncrement correct_increment(const ImuIncrement& inc, const ImuErrors& errors);
 
 /// Remove estimated biases and scale factors from one sample (use this before integration when the biases

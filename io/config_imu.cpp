@@ -125,6 +125,7 @@ const std::vector<SpecKey>& spec_keys() {
       {"gyro_scale_ppm", &ins::ImuSpec::gyro_scale_sigma, 1e-6},
       {"accel_scale_ppm", &ins::ImuSpec::accel_scale_sigma, 1e-6},
       {"scale_tau_s", &ins::ImuSpec::scale_tau_s, 1.0},
+      {"gyro_g_sensitivity_deg_per_s_per_g", &ins::ImuSpec::gyro_g_sensitivity, dps / kG0},
       {"gyro_range_deg_per_s", &ins::ImuSpec::gyro_range, dps},
       {"accel_range_g", &ins::ImuSpec::accel_range, kG0},
   };

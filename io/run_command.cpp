@@ -307,6 +307,12 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
       e["accel_scale_sd_ppm"] = arr(ie.sd.s_a, 1e6);
       e["accel_scale_compensation_ppm"] = arr(ie.accel_scale_compensation, 1e6);
     }
+    if (ie.g_sensitivity) {  // consider states (never estimated): the σ carried, rows of G_g in deg/s per g
+      const double k = kRadToDeg * 9.80665;
+      nlohmann::json rows = nlohmann::json::array();
+      for (int i = 0; i < 3; ++i) rows.push_back({ie.sd.G_g(i, 0) * k, ie.sd.G_g(i, 1) * k, ie.sd.G_g(i, 2) * k});
+      e["gyro_g_sensitivity_consider_sd_deg_per_s_per_g"] = rows;
+    }
     j["imu_estimate"] = e;
   }
   j["zupt"] = {{"detector", c.zupt.detector}, {"form", c.zupt.form}, {"updates", sum.zupt_updates},

@@ -230,6 +230,8 @@ Expected<ScenarioFile> parse_scenario(const std::string& yaml_text, const std::s
       double mis_mrad = o.misalignment_sigma_rad * 1e3;
       m.number("misalignment_mrad", mis_mrad, false, 0.0, 100.0);
       o.misalignment_sigma_rad = mis_mrad * 1e-3;
+      // The truth's g-sensitivity σ: this key, else the spec's (the filter's data-sheet value, docs/error_state.md §5).
+      if (o.spec.gyro_g_sensitivity > 0.0) o.gyro_g_sensitivity_sigma = o.spec.gyro_g_sensitivity;
       double gs = o.gyro_g_sensitivity_sigma * kRadToDeg * kG0;
       m.number("gyro_g_sensitivity_deg_per_s_per_g", gs, false, 0.0, 10.0);
       o.gyro_g_sensitivity_sigma = gs * kDegToRad / kG0;

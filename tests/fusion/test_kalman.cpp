@@ -94,6 +94,42 @@ TEST_P(KalmanSizes, JosephUpdateEqualsTheTextbookFormAndIsSymmetric) {
   EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-12);
 }
 
+// Consider states (Schmidt–Kalman, docs/error_state.md §5): the gain's rows of the consider block are zero, so those
+// states are not corrected, and P is the Joseph covariance of that gain, (I − K_s H) P (I − K_s H)ᵀ + K_s R K_sᵀ —
+// larger than the optimal update's, and the consider block's own variance unchanged.
+TEST_P(KalmanSizes, ConsiderStatesAreNotCorrectedAndPIsTheJosephFormOfTheirGain) {
+  const int n = GetParam();
+  std::mt19937 rng(23u + static_cast<unsigned>(n));
+  std::normal_distribution<double> nd;
+  const ErrorMatrix P0 = random_spd(n, rng);
+  H6 H = H6::Zero(6, n);
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 9; ++j) H(i, 3 + j) = nd(rng);
+  V6 r(6);
+  for (int i = 0; i < 6; ++i) r(i) = nd(rng);
+  R6 R = R6::Zero(6, 6);
+  R.diagonal().setConstant(1e-2);
+  const fusion::ConsiderStates consider{n - 9, 9};
+  ErrorMatrix P = P0;
+  ErrorVector dx;
+  ASSERT_TRUE(fusion::joseph_update(P, H, r, R, dx, [](const auto&, const auto&) {}, consider));
+  const Eigen::MatrixXd Pd = P0, Hd = H, Rd = R;
+  Eigen::MatrixXd K = Pd * Hd.transpose() * (Hd * Pd * Hd.transpose() + Rd).inverse();
+  const Eigen::MatrixXd K_opt = K;
+  K.bottomRows(9).setZero();
+  const Eigen::MatrixXd IKH = Eigen::MatrixXd::Identity(n, n) - K * Hd;
+  EXPECT_LT(rel_diff(P, IKH * Pd * IKH.transpose() + K * Rd * K.transpose()), 1e-11);
+  EXPECT_TRUE(dx.tail(9).isZero(0.0));
+  EXPECT_LT((dx - K * Eigen::VectorXd(r)).norm(), 1e-11 * (K * Eigen::VectorXd(r)).norm());
+  EXPECT_LT(rel_diff(Eigen::MatrixXd(P).bottomRightCorner(9, 9), Pd.bottomRightCorner(9, 9)), 1e-12);
+  // The optimal gain would have corrected them (the test is not vacuous), and P is at least the optimal P.
+  EXPECT_GT(K_opt.bottomRows(9).norm(), 1e-3);
+  const Eigen::MatrixXd IKH_opt = Eigen::MatrixXd::Identity(n, n) - K_opt * Hd;
+  const Eigen::MatrixXd P_opt = IKH_opt * Pd * IKH_opt.transpose() + K_opt * Rd * K_opt.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Eigen::MatrixXd(P) - P_opt);
+  EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-12);
+}
+
 // gain_downdate with R = 0 and a gain K that belongs to another matrix (the filter's P), as the errors-in-variables
 // footprints M use it (docs/consistency.md eq. E.3): M ← (I − K H) M (I − K H)ᵀ exactly, symmetric.
 TEST_P(KalmanSizes, GainDowndateWithZeroNoiseIsTheTwoSidedProjection) {

@@ -69,13 +69,13 @@ TEST(ErrorState, BoxplusBoxminusRoundTrip) {
 }
 
 // True-state continuous dynamics advanced by one tiny Euler step h with measurements (omega_m, f_m):
-// ω = (ω_m - b_g)/(1 + s_g), f = (f_m - b_a)/(1 + s_a); Ṙ = R[ω×] - [ω_ie×]R; v̇ = R f + g - 2ω_ie×v; ṗ = v;
+// f = (f_m - b_a)/(1 + s_a), ω = (ω_m - b_g - G_g f)/(1 + s_g) (G_g: g-sensitivity, a constant); Ṙ = R[ω×] - [ω_ie×]R; v̇ = R f + g - 2ω_ie×v; ṗ = v;
 // ḃ = -b/τ; ṡ = -s/τ_s (scale τ from the spec).
 InsState euler_step(const InsState& x, const Eigen::Vector3d& omega_m, const Eigen::Vector3d& f_m, const ImuSpec& sp,
                     double h) {
   const Eigen::Vector3d w_ie(0.0, 0.0, wgs84::kOmegaIE_radps);
-  const Eigen::Vector3d w = ((omega_m - x.imu.b_g).array() / (1.0 + x.imu.s_g.array())).matrix();
   const Eigen::Vector3d f = ((f_m - x.imu.b_a).array() / (1.0 + x.imu.s_a.array())).matrix();
+  const Eigen::Vector3d w = ((omega_m - x.imu.b_g - x.imu.G_g * f).array() / (1.0 + x.imu.s_g.array())).matrix();
   InsState y = x;
   const Eigen::Matrix3d R = x.nav.R_e_b();
   y.nav.p_eb_e += h * x.nav.v_eb_e;
@@ -88,21 +88,17 @@ InsState euler_step(const InsState& x, const Eigen::Vector3d& omega_m, const Eig
   return y;
 }
 
-TEST(ErrorState, ContinuousFMatchesNumericalDifferentiationThroughBoxplus) {
-  // F_num = (∂/∂δx [step(x ⊞ δx) ⊟ step(x)] - I) / h at δx = 0 (central differences, per-block steps).
+// F_num = (∂/∂δx [step(x ⊞ δx) ⊟ step(x)] - I) / h at δx = 0 (central differences, per-block steps), compared block
+// by block with continuous_error_model; the last 2 states are a clock block the INS model does not own.
+void expect_continuous_f_matches_numerical(const ErrorStateLayout& l, const InsState& x, const Eigen::VectorXd& steps) {
   constexpr double kH_s = 1e-3;
   constexpr double kTolRel = 5e-3;   // J2 part of the gravity gradient is omitted in F (< 0.3 %)
   constexpr double kTolAbs = 1e-6;   // O(h) terms of the Euler step ([ω_ie×] products, ~1e-7)
-  const auto l = layout_with_scale();
   ImuSpec sp = *imu_spec_preset("crista");
   sp.scale_tau_s = 1000.0;
-  const InsState x = sample_state();
   const Eigen::Vector3d omega_m(2.0, -5.0, 1.0), f_m(8.0, -3.0, -12.0);
   const InsState x1 = euler_step(x, omega_m, f_m, sp, kH_s);
-  Eigen::VectorXd steps(l.dim());
-  steps << Eigen::Vector3d::Constant(1.0), Eigen::Vector3d::Constant(1e-4), Eigen::Vector3d::Constant(1e-5),
-      Eigen::Vector3d::Constant(1e-5), Eigen::Vector3d::Constant(1e-5), Eigen::VectorXd::Constant(6, 1e-5),
-      Eigen::VectorXd::Constant(2, 1.0);
+  ASSERT_EQ(steps.size(), l.dim());
   Eigen::MatrixXd J(l.dim(), l.dim());
   for (int i = 0; i < l.dim(); ++i) {
     Eigen::VectorXd d = Eigen::VectorXd::Zero(l.dim());
@@ -114,9 +110,9 @@ TEST(ErrorState, ContinuousFMatchesNumericalDifferentiationThroughBoxplus) {
   Eigen::MatrixXd F_num = (J - Eigen::MatrixXd::Identity(l.dim(), l.dim())) / kH_s;
   F_num.rightCols(2).setZero();  // clock block: not INS-owned
   F_num.bottomRows(2).setZero();
-  // F at the corrected measurements (the model's ω_b, f_b are bias/scale-corrected).
-  const Eigen::Vector3d w = ((omega_m - x.imu.b_g).array() / (1.0 + x.imu.s_g.array())).matrix();
+  // F at the corrected measurements (the model's ω_b, f_b are bias/scale/g-sensitivity-corrected).
   const Eigen::Vector3d f = ((f_m - x.imu.b_a).array() / (1.0 + x.imu.s_a.array())).matrix();
+  const Eigen::Vector3d w = ((omega_m - x.imu.b_g - x.imu.G_g * f).array() / (1.0 + x.imu.s_g.array())).matrix();
   const auto model = continuous_error_model(l, sp, x.nav.R_e_b(), x.nav.p_eb_e, f, w);
   for (const auto& [ri, rb] : l.blocks()) {
     for (const auto& [ci, cb] : l.blocks()) {
@@ -129,7 +125,63 @@ TEST(ErrorState, ContinuousFMatchesNumericalDifferentiationThroughBoxplus) {
   // The scale-factor Jacobian of the true rates is -diag(ω)/(1+s) ≈ -diag(ω): the tolerance above covers it.
 }
 
-TEST(ErrorState, DiscretePhiMatchesNonlinearPropagationOverOneSecondOfFootMotion) {
+TEST(ErrorState, ContinuousFMatchesNumericalDifferentiationThroughBoxplus) {
+  Eigen::VectorXd steps(23);
+  steps << Eigen::Vector3d::Constant(1.0), Eigen::Vector3d::Constant(1e-4), Eigen::Vector3d::Constant(1e-5),
+      Eigen::Vector3d::Constant(1e-5), Eigen::Vector3d::Constant(1e-5), Eigen::VectorXd::Constant(6, 1e-5),
+      Eigen::VectorXd::Constant(2, 1.0);
+  expect_continuous_f_matches_numerical(layout_with_scale(), sample_state(), steps);
+}
+
+// The g-sensitivity block (docs/error_state.md §5): its 9 columns (column-major G_g) against the same numerical
+// Jacobian, at a state with a nonzero G_g.
+ErrorStateLayout layout_with_g_sensitivity() {
+  ErrorStateLayout l;
+  EXPECT_TRUE(l.add(kScaleGyroBlock, 3));
+  EXPECT_TRUE(l.add(kScaleAccBlock, 3));
+  EXPECT_TRUE(l.add(kGSensitivityBlock, 9));
+  EXPECT_TRUE(l.add("clock", 2));
+  return l;
+}
+InsState sample_state_with_g() {
+  InsState x = sample_state();
+  x.imu.G_g << 2e-4, -1e-4, 3e-4, 1e-4, 2.5e-4, -2e-4, -3e-4, 1.5e-4, 1e-4;
+  return x;
+}
+
+TEST(ErrorState, GSensitivityColumnsOfFMatchNumericalDifferentiation) {
+  Eigen::VectorXd steps(32);
+  steps << Eigen::Vector3d::Constant(1.0), Eigen::Vector3d::Constant(1e-4), Eigen::Vector3d::Constant(1e-5),
+      Eigen::Vector3d::Constant(1e-5), Eigen::Vector3d::Constant(1e-5), Eigen::VectorXd::Constant(6, 1e-5),
+      Eigen::VectorXd::Constant(9, 1e-6), Eigen::VectorXd::Constant(2, 1.0);
+  // At Ĝ_g = 0: F leaves out the terms R Ĝ_g (δb_a + diag(f) δs_a) that the estimated g-sensitivity adds to the
+  // attitude rows (docs/error_state.md §5: < 2 °/h for 5 mg of accelerometer bias error at forest_walk's σ).
+  const ErrorStateLayout l = layout_with_g_sensitivity();
+  expect_continuous_f_matches_numerical(l, sample_state(), steps);
+  // And the block is really there: −R f_j per column j (not all zero).
+  ImuSpec sp = *imu_spec_preset("crista");
+  const InsState x = sample_state();
+  const Eigen::Vector3d f(8.0, -3.0, -12.0);
+  const auto model = continuous_error_model(l, sp, x.nav.R_e_b(), x.nav.p_eb_e, f, Eigen::Vector3d(2.0, -5.0, 1.0));
+  const int g = l.find(kGSensitivityBlock)->offset;
+  for (int j = 0; j < 3; ++j) {
+    EXPECT_LT((model.F.block(kAtt.offset, g + 3 * j, 3, 3) + x.nav.R_e_b() * f(j)).norm(), 1e-12) << "column " << j;
+  }
+}
+
+TEST(ErrorState, GSensitivityBoxplusBoxminusRoundTrip) {
+  const auto l = layout_with_g_sensitivity();
+  const InsState x = sample_state_with_g();
+  Eigen::VectorXd dx = Eigen::VectorXd::LinSpaced(l.dim(), -0.3, 0.3);
+  dx.tail(2).setZero();
+  const InsState y = boxplus(x, dx, l);
+  EXPECT_LT((boxminus(y, x, l) - dx).norm(), 5e-9);
+  // Column-major: state 3j + i is G_g(i, j).
+  const int g = l.find(kGSensitivityBlock)->offset;
+  EXPECT_DOUBLE_EQ(y.imu.G_g(1, 2) - x.imu.G_g(1, 2), dx(g + 3 * 2 + 1));
+}
+
+void expect_phi_matches_nonlinear_foot_second(const ErrorStateLayout& l, const Eigen::VectorXd& dx0) {
   // Foot swing (pitch rate up to 7 rad/s), 400 Hz IMU, 20 Hz mechanization, 1 s. Estimated trajectory:
   // mechanize with ImuErrors = 0. True trajectory: x0 ⊞ δx0 mechanized with the SAME increments corrected
   // by the true errors δb, δs. Then δx(1 s) = true ⊟ est must equal Φ_20...Φ_1 δx0 up to
@@ -152,15 +204,12 @@ TEST(ErrorState, DiscretePhiMatchesNonlinearPropagationOverOneSecondOfFootMotion
     if (x.t.seconds() >= t_start - 1e-9) s.push_back(x);
   }
   const auto incs = integrate_all(s, {20.0, true, true});
-  const auto l = layout_with_scale();
   ImuSpec sp = *imu_spec_preset("crista");
   // Constant sensor errors over the 1 s (the true errors are applied to the samples, which needs them fixed).
   sp.gyro_bias_tau_s = sp.accel_bias_tau_s = sp.scale_tau_s = 1e12;
   InsState est;
   est.nav = test::nav_from_kinematics(incs.front().t0, motion.at(incs.front().t0.seconds()));
-  Eigen::VectorXd dx0 = Eigen::VectorXd::Zero(l.dim());
-  dx0 << 0.05, -0.03, 0.02, 0.01, -0.02, 0.015, 1e-3, -2e-3, 1.5e-3, 2e-3, -1e-3, 3e-3, 0.05, -0.04, 0.03, 1e-3,
-      -2e-3, 1e-3, 2e-3, 1e-3, -1e-3, 0.0, 0.0;
+  ASSERT_EQ(dx0.size(), l.dim());
   auto run = [&](double eps, double& rel_residual) {
     InsState e = est;
     InsState tr = boxplus(est, eps * dx0, l);
@@ -196,6 +245,24 @@ TEST(ErrorState, DiscretePhiMatchesNonlinearPropagationOverOneSecondOfFootMotion
   EXPECT_LT(rel_half, kTolRel);
 }
 
+TEST(ErrorState, DiscretePhiMatchesNonlinearPropagationOverOneSecondOfFootMotion) {
+  const auto l = layout_with_scale();
+  Eigen::VectorXd dx0 = Eigen::VectorXd::Zero(l.dim());
+  dx0 << 0.05, -0.03, 0.02, 0.01, -0.02, 0.015, 1e-3, -2e-3, 1.5e-3, 2e-3, -1e-3, 3e-3, 0.05, -0.04, 0.03, 1e-3,
+      -2e-3, 1e-3, 2e-3, 1e-3, -1e-3, 0.0, 0.0;
+  expect_phi_matches_nonlinear_foot_second(l, dx0);
+}
+
+// The same with a g-sensitivity error in the truth (G_g ≈ 1 °/s/g per element): its columns of Φ must carry the
+// swing's specific force into the attitude (docs/error_state.md §5).
+TEST(ErrorState, DiscretePhiWithGSensitivityMatchesNonlinearPropagation) {
+  const auto l = layout_with_g_sensitivity();
+  Eigen::VectorXd dx0 = Eigen::VectorXd::Zero(l.dim());
+  dx0 << 0.05, -0.03, 0.02, 0.01, -0.02, 0.015, 1e-3, -2e-3, 1.5e-3, 2e-3, -1e-3, 3e-3, 0.05, -0.04, 0.03, 1e-3,
+      -2e-3, 1e-3, 2e-3, 1e-3, -1e-3, 1.5e-3, -1e-3, 2e-3, -2e-3, 1e-3, 1.2e-3, 1e-3, -1.5e-3, 1.8e-3, 0.0, 0.0;
+  expect_phi_matches_nonlinear_foot_second(l, dx0);
+}
+
 // The per-step path builds Φ and Q_d from 3x3 blocks (ins::interval_error_model with an output argument); it must
 // equal the generic n x n discretization of continuous_error_model at the interval mid-point, with and without the
 // optional scale blocks, with Gauss-Markov and random-walk biases, and leave foreign blocks (clock) untouched.
@@ -211,9 +278,11 @@ TEST(ErrorState, BlockDiscretizationEqualsGenericSeries) {
   inc.dp_b = 0.5 * inc.dt_s * inc.upsilon_b;
   const InsState x = sample_state();
   const NavState after = mechanize(x.nav, inc);
-  for (const bool with_scale : {true, false}) {
+  for (const int blocks : {0, 1, 2}) {  // none, scale factors, scale factors + g-sensitivity
+    const bool with_scale = blocks > 0;
     for (const bool gauss_markov : {true, false}) {
-      const ErrorStateLayout l = with_scale ? layout_with_scale() : ErrorStateLayout();
+      const ErrorStateLayout l =
+          blocks == 2 ? layout_with_g_sensitivity() : (with_scale ? layout_with_scale() : ErrorStateLayout());
       ImuSpec sp = *imu_spec_preset("gx5_25");
       sp.scale_tau_s = gauss_markov ? 1000.0 : 0.0;
       sp.gyro_scale_sigma = 1e-3;
@@ -235,6 +304,10 @@ TEST(ErrorState, BlockDiscretizationEqualsGenericSeries) {
       if (with_scale && gauss_markov) {
         EXPECT_GT((fast.Qd.block<3, 3>(15, 15).norm()), 0.0);
         EXPECT_GT((fast.Phi.block<3, 3>(kAtt.offset, 15).norm()), 0.0);
+      }
+      if (blocks == 2) {  // every column of G_g reaches the attitude; the block has no noise of its own
+        for (int j = 0; j < 3; ++j) EXPECT_GT((fast.Phi.block<3, 3>(kAtt.offset, 21 + 3 * j).norm()), 0.0);
+        EXPECT_TRUE(fast.Qd.block(21, 21, 9, 9).isZero(0.0));
       }
       const int n = l.dim();
       if (with_scale) {

@@ -157,3 +157,38 @@ TEST(Mechanization, FootMotionAtReducedRatesStaysNearFullRate) {
 
 }  // namespace
 }  // namespace pednav::ins
+
+namespace pednav::ins {
+namespace {
+
+// The g-sensitive gyro error (docs/error_state.md §5): ω_measured = (1 + s_g) ω + b_g + G_g f with f the true
+// specific force. correct_sample removes it with the corrected specific force; correct_increment with the corrected
+// plain velocity increment (∫ G_g f dt = G_g υ).
+TEST(Mechanization, CorrectionRemovesTheGSensitiveRate) {
+  ImuErrors e;
+  e.b_g = Eigen::Vector3d(0.01, -0.02, 0.005);
+  e.b_a = Eigen::Vector3d(0.05, 0.1, -0.08);
+  e.G_g << 2e-3, -1e-3, 3e-3, 1e-3, 2.5e-3, -2e-3, -3e-3, 1.5e-3, 1e-3;
+  const Eigen::Vector3d omega(1.5, -4.0, 0.3), f(12.0, -3.0, -25.0);
+  ImuSample s;
+  s.omega_ib_b = omega + e.b_g + e.G_g * f;
+  s.f_ib_b = f + e.b_a;
+  const ImuSample c = correct_sample(s, e);
+  EXPECT_LT((c.f_ib_b - f).norm(), 1e-12);
+  EXPECT_LT((c.omega_ib_b - omega).norm(), 1e-12);
+  ImuIncrement inc;
+  inc.dt_s = 0.05;
+  inc.alpha_b = inc.dtheta_b = s.omega_ib_b * inc.dt_s;
+  inc.upsilon_b = inc.dv_b = s.f_ib_b * inc.dt_s;
+  inc.omega_end_b = s.omega_ib_b;
+  inc.f_end_b = s.f_ib_b;
+  const ImuIncrement ci = correct_increment(inc, e);
+  EXPECT_LT((ci.alpha_b - omega * inc.dt_s).norm(), 1e-12);
+  EXPECT_LT((ci.dtheta_b - omega * inc.dt_s).norm(), 1e-12);
+  EXPECT_LT((ci.omega_end_b - omega).norm(), 1e-12);
+  // Without the G term the rate would be off by |G f| ≈ 0.1 rad/s here: the check above is not vacuous.
+  EXPECT_GT((e.G_g * f).norm(), 0.05);
+}
+
+}  // namespace
+}  // namespace pednav::ins

@@ -281,6 +281,27 @@ TEST(Config, HeadingFrameLeverArmKeyReachesTheEngineAndRoundTrips) {
   EXPECT_THAT(bad.error().message, HasSubstr("antenna.lever_arm_heading_m"));
 }
 
+// The gyro g-sensitivity σ of the IMU spec (docs/error_state.md §5): deg/s per g in the file, rad/s per m/s² inside,
+// through engine_options to the filter, kept by config.resolved.yaml; a negative value names the key.
+TEST(Config, GyroGSensitivitySpecKeyReachesTheEngineAndRoundTrips) {
+  const std::string files = "mode: tc\nrover_obs: r.obs\nnav: n.nav\n";
+  auto def = parse(files + "imu: {file: i.csv, format: pyshoe, spec: crista}\n");
+  ASSERT_TRUE(def) << def.error().message;
+  EXPECT_EQ(engine_options(*def).spec.gyro_g_sensitivity, 0.0);
+  auto cfg = parse(files + "imu: {file: i.csv, format: pyshoe, spec: {preset: crista, "
+                           "gyro_g_sensitivity_deg_per_s_per_g: 0.1}}\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  const double expected = 0.1 * kDegToRad / 9.80665;
+  EXPECT_NEAR(engine_options(*cfg).spec.gyro_g_sensitivity, expected, 1e-15);
+  auto again = parse(to_yaml(*cfg));
+  ASSERT_TRUE(again) << again.error().message << "\n" << to_yaml(*cfg);
+  EXPECT_NEAR(again->imu.spec.gyro_g_sensitivity, expected, 1e-12);
+  auto bad = parse(files + "imu: {file: i.csv, format: pyshoe, spec: {preset: crista, "
+                           "gyro_g_sensitivity_deg_per_s_per_g: -0.1}}\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("gyro_g_sensitivity_deg_per_s_per_g"));
+}
+
 TEST(Config, MultipathAndScaleFactorStateKeys) {
   auto cfg = parse(
       "mode: gnss\nrover_obs: r.obs\nnav: n.nav\nmultipath:\n  states: true\n  sigma_m: 0.5\n  tau_s: 30\n"
