@@ -334,6 +334,8 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
       "window,start_gps_week,start_gps_tow_s,duration_s,keep_sats,sats_left_min,sats_left_mean,sats_left_max,"
       "gnss_epochs_emptied,max_error_m,end_error_m,max_error_smoothed_m,end_error_smoothed_m,max_error_vs_run_m,"
       "end_error_vs_run_m,max_error_smoothed_vs_run_m,end_error_smoothed_vs_run_m\n";
+  // Without a smoothed nominal run (smoother off, or consider states) the smoothed columns stay empty.
+  const bool has_s = res.has_smoothed;
   for (size_t k = 0; k < nw; ++k) {
     const auto& f = res.forward.per_window[k];
     const auto& s = res.smoothed.per_window[k];
@@ -343,9 +345,9 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
                        res.windows[k].start.week(), res.windows[k].start.tow_s(), res.windows[k].duration_s,
                        a.keep_sats, res.sats_kept_min[k], res.sats_kept_mean[k], res.sats_kept_max[k],
                        res.epochs_masked[k], fmt_opt(f.max_m, f.samples > 0), fmt_opt(f.end_m, f.samples > 0),
-                       fmt_opt(s.max_m, s.samples > 0), fmt_opt(s.end_m, s.samples > 0),
+                       fmt_opt(s.max_m, has_s && s.samples > 0), fmt_opt(s.end_m, has_s && s.samples > 0),
                        fmt_opt(fr.max_m, fr.samples > 0), fmt_opt(fr.end_m, fr.samples > 0),
-                       fmt_opt(sr.max_m, sr.samples > 0), fmt_opt(sr.end_m, sr.samples > 0));
+                       fmt_opt(sr.max_m, has_s && sr.samples > 0), fmt_opt(sr.end_m, has_s && sr.samples > 0));
   }
   if (auto ok = write_file_atomic((out / "outages.csv").string(), csv); !ok) return ok.error();
   if (a.write_runs) {

@@ -100,6 +100,29 @@ TEST_F(OutageCommand, FullOutageEmptiesEpochsAndDriftsFromTheRunWithoutOutage) {
   EXPECT_GT(r->forward_vs_run.max_error_m, kMinFullOutageDrift_m);
 }
 
+// Without a smoothed solution (here: the smoother switched off; the g-sensitivity consider states do the same) the
+// smoothed columns of outages.csv are empty, not copies of the forward figures.
+TEST_F(OutageCommand, SmoothedColumnsAreEmptyWithoutASmoother) {
+  io::RunConfig c = config();
+  c.smoother_enabled = false;
+  const io::OutageArgs a = args("nosmooth", 3);
+  auto r = io::run_outage_command(c, a);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  EXPECT_FALSE(r->has_smoothed);
+  const std::string csv = test::read_text(a.out_dir + "/outages.csv");
+  const size_t line2 = csv.find('\n') + 1;
+  const std::string row = csv.substr(line2, csv.find('\n', line2) - line2);
+  std::vector<std::string> cells;
+  for (size_t b = 0, e; b <= row.size(); b = e + 1) {
+    e = row.find(',', b);
+    if (e == std::string::npos) e = row.size();
+    cells.push_back(row.substr(b, e - b));
+  }
+  ASSERT_EQ(cells.size(), 17u) << row;
+  EXPECT_FALSE(cells[9].empty()) << "forward max error";
+  for (int i : {11, 12, 15, 16}) EXPECT_TRUE(cells[i].empty()) << "column " << i << " of " << row;
+}
+
 TEST_F(OutageCommand, BadOptionsAreNamed) {
   io::OutageArgs a = args("bad", 3);
   a.windows = 50;
