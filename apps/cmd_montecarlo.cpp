@@ -481,8 +481,8 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
                 "beside the walking line (antenna.lever_arm_heading_m = [0, -gait.foot_offset_m, 0]; docs/fusion.md §14) "
                 "instead of pednav run's default [0, 0, -1.2] m");
   cmd->add_flag("--g-sensitivity-states", mo->g_sensitivity_states,
-                "Filter states for the gyro's g-sensitivity matrix (9, random constants) with the scenario's σ "
-                "(imu.spec gyro_g_sensitivity_deg_per_s_per_g; docs/error_state.md §5)");
+                "The gyro's g-sensitivity matrix as 9 consider states (carried in P, never corrected; no smoothed "
+                "solution) with the scenario's σ (imu.spec gyro_g_sensitivity_deg_per_s_per_g; docs/error_state.md §5)");
   cmd->add_option("--scale-bias-compensation", mo->scale_bias_compensation,
                   "true/false: subtract the errors-in-variables bias of the scale-factor updates "
                   "(scale_factors.bias_compensation, default true; docs/consistency.md §3.6-3.7)");

@@ -482,7 +482,7 @@ class Filter {
   static constexpr int64_t kNeverNs = std::numeric_limits<int64_t>::min();
   ins::Block mp_block_{0, 0};
   int g_sens_offset_ = -1;  // g-sensitivity block (docs/error_state.md §5), −1 without it
-  ConsiderStates consider_;  // states the updates never correct (Schmidt–Kalman): the g-sensitivity unless estimated
+  ConsiderStates consider_;  // states the updates never correct (Schmidt–Kalman): the g-sensitivity block
   std::vector<double> mp_value_;
   std::vector<gnss::SatId> mp_sat_;
   std::vector<int64_t> mp_last_ns_;
@@ -999,7 +999,7 @@ class Runner {
       const Vector3d omega_ie_b = f.x().nav.R_e_b().transpose() * Vector3d(0, 0, wgs84::kOmegaIE_radps);
       r.tail<3>() = inc.alpha_b / inc.dt_s - omega_ie_b;  // = true - estimated bias if the foot is still
       H.block<3, 3>(3, ins::kBiasGyro.offset).setIdentity();
-      // The g-sensitive part δG_g f of the corrected rate (docs/error_state.md eq. 5.3): without it the ZARU would
+      // The g-sensitive part δG_g f of the corrected rate (docs/error_state.md eq. 5.4): without it the ZARU would
       // tell the bias apart from G_g f at rest, and the tilt drift the ZUPTs see would then "observe" G_g.
       if (const int g = f.g_sensitivity_offset(); g >= 0) {
         const Vector3d f_b = inc.upsilon_b / inc.dt_s;

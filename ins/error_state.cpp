@@ -76,7 +76,7 @@ Eigen::VectorXd boxminus(const InsState& a, const InsState& b, const ErrorStateL
 // docs/error_state.md eq. (3.1)-(3.8):
 //   δṗ = δv
 //   δv̇ = Γ δp - 2[ω_ie×] δv - [f_e×] φ - R δb_a - R diag(f_b) δs_a - R n_a
-//   φ̇  = -[ω_ie×] φ - R δb_g - R diag(ω_b) δs_g - R δG_g f_b - R n_g   (δG_g f_b = Σ_j f_b,j δG_g[:, j], §6)
+//   φ̇  = -[ω_ie×] φ - R δb_g - R diag(ω_b) δs_g - R δG_g f_b - R n_g   (δG_g f_b = Σ_j f_b,j δG_g[:, j], docs/error_state.md §5)
 //   δḃ = -δb/τ + w_b  (τ <= 0: random walk),   δṡ = -δs/τ_s + w_s
 ContinuousErrorModel continuous_error_model(const ErrorStateLayout& layout, const ImuSpec& spec,
                                             const Eigen::Matrix3d& R_e_b, const Eigen::Vector3d& p_eb_e,
@@ -177,8 +177,9 @@ DiscreteErrorModel discretize(const ContinuousErrorModel& model, double dt_s, Qd
 namespace {
 
 // The INS error model of eq. (3.1)-(3.8) as a matrix of 3x3 blocks (at most 10 x 10: pos, vel, att, gyro bias,
-// accel bias, gyro scale, accel scale, the three columns of G_g) with a flag per nonzero block: Φ and Q_d of the series method are
-// products of a few 3x3 blocks (docs/error_state.md §4, docs/performance.md §1), not of n x n matrices.
+// accel bias, gyro scale, accel scale, the three columns of G_g) with a flag per nonzero block: Φ and Q_d of the
+// series method are products of a few 3x3 blocks (docs/error_state.md §4, docs/performance.md §1), not of n x n
+// matrices.
 constexpr int kMaxInsBlocks = 10;
 struct Blocks3 {
   std::array<int, kMaxInsBlocks> offset{};
@@ -308,7 +309,7 @@ void interval_error_model(const ErrorStateLayout& layout, const ImuSpec& spec, c
     if (spec.scale_tau_s > 0.0) F.set(s, s, -I / spec.scale_tau_s);
     S[s] = psd_gm(spec.accel_scale_sigma, spec.scale_tau_s);
   }
-  if (const auto gs = layout.find(kGSensitivityBlock)) {  // column j of G_g: φ̇ ∋ −R f_b,j δG_g[:, j] (§6)
+  if (const auto gs = layout.find(kGSensitivityBlock)) {  // column j of G_g: φ̇ ∋ −R f_b,j δG_g[:, j] (docs/error_state.md eq. 5.3)
     for (int j = 0; j < 3; ++j) {
       const int s = F.count++;
       F.offset[s] = gs->offset + 3 * j;

@@ -27,7 +27,7 @@ struct ImuSpec {
   double accel_scale_sigma = 0.0;       ///< [-]
   double scale_tau_s = 0.0;             ///< scale-factor GM correlation time [s]; <= 0: random constant
   /// g-sensitive gyro error: σ of each element of G in ω_measured = … + G f [rad/s per m/s^2] (random constants);
-  /// 0 = not modelled. > 0 gives the filter 9 G states (docs/error_state.md §5).
+  /// 0 = not modelled. > 0 gives the filter 9 consider states for G (docs/error_state.md §5).
   double gyro_g_sensitivity = 0.0;
   double gyro_range = 0.0;              ///< full scale [rad/s] (0 = unknown; saturation not checked)
   double accel_range = 0.0;             ///< full scale [m/s^2]
