@@ -439,9 +439,9 @@ class Filter {
       e.sd.s_a = sd(b->offset);
       for (int i = 0; i < 3; ++i) e.accel_scale_compensation(i) = eiv_correction(b->offset + i);
     }
-    if (const auto b = layout_.find(ins::kGSensitivityBlock)) {
+    if (g_sens_offset_ >= 0) {
       e.g_sensitivity = true;
-      for (int k = 0; k < 9; ++k) e.sd.G_g(k % 3, k / 3) = std::sqrt(P_(b->offset + k, b->offset + k));
+      for (int k = 0; k < 9; ++k) e.sd.G_g(k % 3, k / 3) = std::sqrt(P_(g_sens_offset_ + k, g_sens_offset_ + k));
     }
     return e;
   }
