@@ -397,7 +397,7 @@ int run_montecarlo(const McOptions& mo) {
   j["runs_done_now"] = todo.size();
   j["jobs"] = jobs;
   j["nees_in_band_fraction_forward"] = sf.nees_in_band_fraction;
-  // No smoothed epochs (--no-smoother, or consider states, which the backward pass does not support): null, not 0.
+  // No smoothed epochs (--no-smoother, or a re-initialized run): null, not 0.
   const bool have_smoothed = ss.epochs > 0;
   auto smoothed_value = [&](double v) { return have_smoothed ? nlohmann::json(v) : nlohmann::json(nullptr); };
   j["nees_in_band_fraction_smoothed"] = smoothed_value(ss.nees_in_band_fraction);
@@ -481,8 +481,8 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
                 "beside the walking line (antenna.lever_arm_heading_m = [0, -gait.foot_offset_m, 0]; docs/fusion.md §14) "
                 "instead of pednav run's default [0, 0, -1.2] m");
   cmd->add_flag("--g-sensitivity-states", mo->g_sensitivity_states,
-                "The gyro's g-sensitivity matrix as 9 consider states (carried in P, never corrected; no smoothed "
-                "solution) with the scenario's σ (imu.spec gyro_g_sensitivity_deg_per_s_per_g; docs/error_state.md §5)");
+                "The gyro's g-sensitivity matrix as 9 consider states (carried in P, never corrected by the forward "
+                "filter; the smoother estimates them) with the scenario's σ (imu.spec gyro_g_sensitivity_deg_per_s_per_g; docs/error_state.md §5)");
   cmd->add_option("--scale-bias-compensation", mo->scale_bias_compensation,
                   "true/false: subtract the errors-in-variables bias of the scale-factor updates "
                   "(scale_factors.bias_compensation, default true; docs/consistency.md §3.6-3.7)");

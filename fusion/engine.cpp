@@ -199,15 +199,31 @@ class Filter {
     // subtracted totals change by < 2 % on the large ones, 5 % on the smallest, at about half the cost).
     eiv_dim_ = clock_blocks_.empty() ? layout_.dim() : clock_blocks_.front().offset;
     for (auto& t : eiv_) t.M.setZero(eiv_dim_, eiv_dim_);  // no noise footprint yet (also at a re-init)
+    // The same footprints for the smoother's Kalman-gain filter (consider states only), over the whole state: its
+    // gain also corrects the consider states, and the INS block alone is not stable under that gain (the footprint
+    // grew to 1e10 on the 1 °/s/g test walk).
+    eivo_ = eiv_;
+    for (auto& t : eivo_) t.M.setZero(layout_.dim(), layout_.dim());
     interval_.restart(P_);  // sized; the smoother's bookkeeping starts at the first output epoch (smoother_restart)
+    // With consider states the smoother runs on the Kalman-gain filter of the same linearization (docs/fusion.md
+    // §12.6): its covariance starts as the filter's, its conditional mean of the error at zero.
+    shadow_ = consider_.count > 0 && o_.smoother_enabled;
+    if (shadow_) {
+      Po_ = P_;
+      eta_.setZero(P_.rows());
+    }
   }
 
   // Replace the variance of a 3-state block (position [m], velocity [m/s]) by sigma² per axis, uncorrelated
   // (re-initialization).
   void set_block_sigma(const ins::Block& b, double sigma) {
-    P_.middleRows<3>(b.offset).setZero();
-    P_.middleCols<3>(b.offset).setZero();
-    P_.block<3, 3>(b.offset, b.offset) = Eigen::Matrix3d::Identity() * sigma * sigma;
+    for (ErrorMatrix* P : {&P_, &Po_}) {
+      if (P == &Po_ && !shadow_) continue;
+      P->middleRows<3>(b.offset).setZero();
+      P->middleCols<3>(b.offset).setZero();
+      P->block<3, 3>(b.offset, b.offset) = Eigen::Matrix3d::Identity() * sigma * sigma;
+    }
+    if (shadow_) eta_.segment<3>(b.offset).setZero();
   }
 
   // Mechanize one (already bias-corrected) increment and propagate the covariance.
@@ -251,7 +267,13 @@ class Filter {
     // Smoother: the cross-covariance of the error at the last output epoch with the current error, Γ ← Γ Φᵀ
     // (docs/fusion.md eq. 12.15).
     if (recording_) interval_.predict(Phi_sparse_);
-    if (!eiv_.empty()) eiv_predict(inc.dt_s, x_.nav, after);
+    if (!eiv_.empty()) eiv_predict(inc.dt_s, x_.nav, after, eiv_, P_);
+    if (shadow_ && !eivo_.empty()) eiv_predict(inc.dt_s, x_.nav, after, eivo_, Po_);
+    if (shadow_) {  // the Kalman-gain filter of the smoother (docs/fusion.md eq. 12.22): η ← Φ η, P_o ← Φ P_o Φᵀ + Q_d
+      Phi_sparse_.times(eta_, eta_tmp_);
+      eta_ = eta_tmp_;
+      covariance_predict(Po_, Phi_sparse_, m.Qd, tmp_);
+    }
     covariance_predict(P_, Phi_sparse_, m.Qd, tmp_);
     x_.nav = after;
   }
@@ -274,21 +296,48 @@ class Filter {
     // Errors-in-variables compensation (docs/consistency.md eq. E.4): the mean noise part of each scale correction.
     double eiv_bias[kMaxEivTerms];
     const bool ok = joseph_update(P_, H, r, R, dx, [&](const auto& S_ldlt, const auto& K) {
-      if (recording_) interval_.update(H, r, S_ldlt, K);
+      if (recording_ && !shadow_) interval_.update(H, r, S_ldlt, K);
       if (eiv_.empty()) return;
       int nz[ins::kMaxErrorDim];
       const int n_nz = nonzero_columns(H, nz);
       for (size_t j = 0; j < eiv_.size(); ++j) eiv_bias[j] = eiv_update(eiv_[j].M, H, nz, n_nz, S_ldlt, K);
     }, consider_);
     if (!ok) return false;
+    if (shadow_) {
+      // The smoother's Kalman-gain filter (docs/fusion.md eq. 12.23) conditions its mean η of the error on the same
+      // residual, ν = r − H η; the smoother's interval uses its S and gain.
+      VecR nu = r;
+      nu.noalias() -= H * eta_;
+      // Its gain has the same errors-in-variables mean as the filter's (docs/consistency.md eq. E.4), from its own
+      // footprints; without the subtraction η's scale part drifts by it at every update.
+      ErrorVector dxo;
+      double eivo_bias[kMaxEivTerms];
+      if (joseph_update(Po_, H, nu, R, dxo, [&](const auto& So_ldlt, const auto& Ko) {
+            if (recording_) interval_.update(H, nu, So_ldlt, Ko);
+            if (eivo_.empty()) return;
+            int nz[ins::kMaxErrorDim];
+            const int n_nz = nonzero_columns(H, nz);
+            for (size_t j = 0; j < eivo_.size(); ++j) {
+              eivo_bias[j] = eiv_update(eivo_[j].M, H, nz, n_nz, So_ldlt, Ko);
+            }
+          })) {
+        for (size_t j = 0; j < eivo_.size(); ++j) {
+          dxo(eivo_[j].state) -= eivo_bias[j];
+          eivo_[j].total += eivo_bias[j];
+          if (recording_) interval_.shift_mean(eivo_[j].state, -eivo_bias[j]);  // eq. E.6 for the smoother's filter
+        }
+        eta_ += dxo;
+      }
+    }
     for (size_t j = 0; j < eiv_.size(); ++j) {
       dx(eiv_[j].state) -= eiv_bias[j];
       eiv_[j].total += eiv_bias[j];
       // The smoother conditions on the same residual: without this its scale estimate at the interval's start would
-      // take the subtraction back (docs/consistency.md eq. E.6).
-      if (recording_) interval_.shift_mean(eiv_[j].state, -eiv_bias[j]);
+      // take the subtraction back (docs/consistency.md eq. E.6). With consider states η carries it (eq. 12.23).
+      if (recording_ && !shadow_) interval_.shift_mean(eiv_[j].state, -eiv_bias[j]);
     }
     apply(dx);
+    if (shadow_) eta_ -= dx;  // the nominal moved by dx: the error's conditional mean moves by −dx (eq. 12.23)
     return true;
   }
 
@@ -323,10 +372,7 @@ class Filter {
     mp_sat_[lru] = sat;
     mp_last_ns_[lru] = t_ns;
     mp_value_[lru] = 0.0;
-    P_.row(k).setZero();
-    P_.col(k).setZero();
-    P_(k, k) = 1.0;
-    if (recording_) interval_.restart_state(k);  // a fresh variable for the smoother too (docs/fusion.md eq. 12.19)
+    restart_variable(k, 1.0);
     reset = true;
     return lru;
   }
@@ -341,6 +387,16 @@ class Filter {
 
   // P <- J P J^T with J = I except the (velocity, attitude) block = A (docs/fusion.md eq. 5.9).
   void reexpress_velocity_attitude(const Eigen::Matrix3d& A) {
+    reexpress_velocity_attitude(A, P_);
+    if (shadow_) {  // the smoother's Kalman-gain filter: P_o ← J P_o Jᵀ, η ← J η
+      reexpress_velocity_attitude(A, Po_);
+      const Vector3d eta_att = eta_.segment<3>(ins::kAtt.offset);
+      eta_.segment<3>(ins::kVel.offset) += A * eta_att;
+    }
+    // The smoother's cross-covariance follows the coordinate change: Γ ← Γ Jᵀ (docs/fusion.md eq. 12.18).
+    if (recording_) interval_.reexpress(ins::kVel.offset, ins::kAtt.offset, A);
+  }
+  static void reexpress_velocity_attitude(const Eigen::Matrix3d& A, ErrorMatrix& P_) {
     // J P J^T = P + E_v A P_φ· + P_·φ A^T E_v^T + E_v A P_φφ A^T E_v^T
     const int v = ins::kVel.offset, a = ins::kAtt.offset;
     Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3, ins::kMaxErrorDim> APa;
@@ -353,36 +409,56 @@ class Filter {
     // the rounding of A P_φφ Aᵀ): symmetrize that block (the whole matrix would cost n² per ZUPT).
     const Eigen::Matrix3d Pvv = P_.block<3, 3>(v, v);
     P_.block<3, 3>(v, v) = 0.5 * (Pvv + Pvv.transpose());
-    // The smoother's cross-covariance follows the coordinate change: Γ ← Γ Jᵀ (docs/fusion.md eq. 12.18).
-    if (recording_) interval_.reexpress(v, a, A);
+  }
+
+  // State i restarted as a fresh variable of the given variance, independent of everything before (clock, drift,
+  // multipath slot): in P, in the smoother's Kalman-gain filter and in the smoother's interval (eq. 12.19).
+  void restart_variable(int i, double variance) {
+    for (ErrorMatrix* P : {&P_, &Po_}) {
+      if (P == &Po_ && !shadow_) continue;
+      P->row(i).setZero();
+      P->col(i).setZero();
+      (*P)(i, i) = variance;
+    }
+    if (shadow_) eta_(i) = 0.0;
+    if (recording_) interval_.restart_state(i);
   }
 
   // Reset a clock to a new value with a large variance (receiver clock jump).
   void reset_clock(int slot, double value_m, double sigma_m) {
     const int c = clock_blocks_[slot].offset;
     clock_m_[slot] = value_m;
-    P_.row(c).setZero();
-    P_.col(c).setZero();
-    P_(c, c) = sigma_m * sigma_m;
-    if (recording_) interval_.restart_state(c);  // docs/fusion.md eq. 12.19
+    restart_variable(c, sigma_m * sigma_m);
   }
   void reset_drift(double value_mps, double sigma_mps) {
     const int d = drift_block_.offset;
     drift_mps_ = value_mps;
-    P_.row(d).setZero();
-    P_.col(d).setZero();
-    P_(d, d) = sigma_mps * sigma_mps;
-    if (recording_) interval_.restart_state(d);  // docs/fusion.md eq. 12.19
+    restart_variable(d, sigma_mps * sigma_mps);
   }
 
   /// Start a smoother interval at the current step (an output epoch, after all its updates; docs/fusion.md eq.
   /// 12.14); from here on every prediction, update, re-expression and reset is also applied to the interval.
   void smoother_restart() {
-    interval_.restart(P_);
+    if (shadow_) {
+      interval_.restart(Po_, eta_);  // eq. 12.21
+    } else {
+      interval_.restart(P_);
+    }
     recording_ = true;
   }
-  /// The backward record of the interval from the last smoother_restart() to the current step (eq. 12.20).
-  void smoother_close(RtsSegment& out) const { interval_.close(P_, out); }
+  /// The backward record of the interval from the last smoother_restart() to the current step (eq. 12.20; with
+  /// consider states eq. 12.24).
+  void smoother_close(RtsSegment& out) const {
+    if (shadow_) {
+      interval_.close(Po_, eta_, out);
+    } else {
+      interval_.close(P_, out);
+    }
+  }
+  /// Var and conditional mean of the error at the current step as the smoother sees them: the filter's P and 0, or
+  /// with consider states the Kalman-gain filter's P_o and η (docs/fusion.md §12.6).
+  const ErrorMatrix& smoother_P() const { return shadow_ ? Po_ : P_; }
+  ErrorVector smoother_mean() const { return shadow_ ? eta_ : ErrorVector::Zero(P_.rows()); }
   /// Stop the smoother's bookkeeping (a re-initialization: the backward pass cannot cross it).
   void smoother_stop() { recording_ = false; }
 
@@ -502,12 +578,14 @@ class Filter {
     double total = 0.0;
   };
   std::vector<EivTerm> eiv_;
+  std::vector<EivTerm> eivo_;  // the same for the smoother's Kalman-gain filter (consider states, docs/fusion.md §12.6)
   ErrorMatrix eiv_tmp_, eiv_zero_;
   int eiv_dim_ = 0;
   ColumnSparse<ins::kMaxErrorDim> eiv_Phi_;
 
-  void eiv_predict(double dt, const ins::NavState& before, const ins::NavState& after) {
-    const int n = eiv_dim_;
+  void eiv_predict(double dt, const ins::NavState& before, const ins::NavState& after, std::vector<EivTerm>& terms,
+                   const ErrorMatrix& P) {
+    const int n = terms.empty() ? 0 : static_cast<int>(terms.front().M.rows());
     if (eiv_zero_.rows() != n) eiv_zero_.setZero(n, n);
     if (n != layout_.dim()) eiv_Phi_.assign(model_.Phi.topLeftCorner(n, n));
     const auto& Phi = n != layout_.dim() ? eiv_Phi_ : Phi_sparse_;
@@ -515,14 +593,13 @@ class Filter {
     // The noise ν_u of every scale term u's regressor enters P's column of scale state t through P_tu (its own column
     // of Φ times P_{s_u s_t}), and the error through g_u: M_t gains Σ_u P_tu σ_u² Δt g_u g_uᵀ (docs/consistency.md
     // eq. E.5; only u = t in session 9).
-    for (auto& t : eiv_) {
-      if (t.M.rows() != n) t.M.setZero(n, n);
+    for (auto& t : terms) {
       covariance_predict(t.M, Phi, eiv_zero_, eiv_tmp_);
-      for (const auto& u : eiv_) {
+      for (const auto& u : terms) {
         const double psd = u.gyro ? spec_.gyro_arw * spec_.gyro_arw : spec_.accel_vrw * spec_.accel_vrw;
         const Vector3d g = R.col(u.axis);
         t.M.block<3, 3>(u.block_offset, u.block_offset).noalias() +=
-            (P_(t.state, u.state) * psd * dt) * (g * g.transpose());
+            (P(t.state, u.state) * psd * dt) * (g * g.transpose());
       }
     }
   }
@@ -551,6 +628,11 @@ class Filter {
   // output epoch on.
   bool recording_ = false;
   RtsInterval interval_;
+  // With consider states: the Kalman-gain filter of the same linearization that the smoother runs on (docs/fusion.md
+  // §12.6): its covariance P_o = Var(δx | Y) and the conditional mean η = E[δx | Y] of the forward filter's error.
+  bool shadow_ = false;
+  ErrorMatrix Po_;
+  ErrorVector eta_, eta_tmp_;
 };
 
 // Median of v (reorders v; no copy).
@@ -664,13 +746,8 @@ class Runner {
     // Smoother (docs/fusion.md §12): one backward record per output epoch, carried forward from each output epoch
     // to the next by the filter (eqs. 12.14-12.20).
     // Consider states (the g-sensitivity, docs/error_state.md §5) leave the forward error with a non-zero conditional
-    // mean and correlated innovations, which the backward pass assumes away: no smoothing with them.
-    const bool smooth = o_.smoother_enabled && !f.has_consider_states();
-    if (o_.smoother_enabled && !smooth) {
-      sum.smoother_message =
-          "not smoothed: the gyro g-sensitivity states are consider states (Schmidt-Kalman), which the RTS pass does "
-          "not support (docs/error_state.md §5)";
-    }
+    // mean: the smoother then runs on the Kalman-gain filter of the same linearization (§12.6).
+    const bool smooth = o_.smoother_enabled;
     const int n_state = f.layout().dim();
     RtsSegment segment;
     RtsStore segments(n_state);
@@ -881,7 +958,8 @@ class Runner {
       result.smoothed.resize(result.epochs.size());
       bool finite = true;
       size_t bad = 0;
-      rts_backward(segments, tail, f.P(), [&](size_t k, const ErrorVector& dx, const ErrorMatrix& P) {
+      rts_backward(segments, tail, f.smoother_P(), f.smoother_mean(), [&](size_t k, const ErrorVector& dx,
+                                                                           const ErrorMatrix& P) {
         // Smoothed state = forward nominal ⊞ smoothed error (eq. 12.12).
         const ins::InsState xs = ins::boxplus(nominal_at_output[k], dx, f.layout());
         const EpochOutput& fwd = result.epochs[k];

@@ -75,6 +75,11 @@ void RtsInterval::restart(const ErrorMatrix& P_a) {
   steps_ = 0;
 }
 
+void RtsInterval::restart(const ErrorMatrix& P_a, const ErrorVector& eta_a) {
+  restart(P_a);
+  mu_ = eta_a;  // eq. 12.21: E[δx_a | Y_a] = η_a
+}
+
 void RtsInterval::predict(const ColumnSparse<ins::kMaxErrorDim>& Phi) {
   // Γ ← Γ Φᵀ as sums of whole columns, (Γ Φᵀ).col(r) += Φ_rc Γ.col(c), as the filter's P Φᵀ (eq. 12.15).
   tmp_.setZero(Gamma_.rows(), Gamma_.cols());
@@ -105,6 +110,10 @@ void RtsInterval::restart_state(int i) {
 }
 
 void RtsInterval::close(const ErrorMatrix& P_b, RtsSegment& out) const {
+  close(P_b, ErrorVector::Zero(Gamma_.rows()), out);
+}
+
+void RtsInterval::close(const ErrorMatrix& P_b, const ErrorVector& eta_b, RtsSegment& out) const {
   const int n = static_cast<int>(Gamma_.rows());
   if (steps_ == 0) {  // b = a: the identity map (what the per-step composition gives for no steps)
     out.M.setIdentity(n, n);
@@ -119,7 +128,9 @@ void RtsInterval::close(const ErrorMatrix& P_b, RtsSegment& out) const {
   const Eigen::LDLT<ErrorMatrix> ldlt(scaled);
   const ErrorMatrix Mt = D.asDiagonal() * ldlt.solve(D.asDiagonal() * Gamma_.transpose());
   out.M = Mt.transpose();
+  // E[δx_a | δx_b, Y_b] = μ + M (δx_b − η_b) (eq. 12.24; η_b = 0 for a Kalman gain, eq. 12.20).
   out.m = mu_;
+  out.m.noalias() -= out.M * eta_b;
   out.S = V_;  // S = Var(δx_a | δx_b, Y_b) = V − M Γᵀ (eq. 12.20)
   out.S.noalias() -= out.M * Gamma_.transpose();
   out.S = 0.5 * (out.S + out.S.transpose()).eval();
@@ -154,7 +165,15 @@ void RtsStore::get(size_t i, RtsSegment& out) const {
 void rts_backward(const RtsStore& store, const RtsSegment& tail, const ErrorMatrix& P_last,
                   const std::function<void(size_t, const ErrorVector&, const ErrorMatrix&)>& visit) {
   // At the last step the smoothed error is the filtered one, zero after the closed-loop reset (eq. 12.10).
+  rts_backward(store, tail, P_last, ErrorVector::Zero(P_last.rows()), visit);
+}
+
+void rts_backward(const RtsStore& store, const RtsSegment& tail, const ErrorMatrix& P_last,
+                  const ErrorVector& eta_last,
+                  const std::function<void(size_t, const ErrorVector&, const ErrorMatrix&)>& visit) {
+  // At the last step the smoothed error is the filtered conditional mean η_N (eq. 12.25; 0 for a Kalman gain).
   ErrorVector dx = tail.m;
+  dx.noalias() += tail.M * eta_last;
   ErrorMatrix P = tail.S + tail.M * P_last * tail.M.transpose();
   visit(store.size(), dx, P);
   RtsSegment s;
@@ -172,11 +191,16 @@ void rts_backward(const RtsStore& store, const RtsSegment& tail, const ErrorMatr
 
 std::vector<RtsSmoothed> rts_backward(const std::vector<RtsSegment>& segments, const RtsSegment& tail,
                                       const ErrorMatrix& P_last) {
+  return rts_backward(segments, tail, P_last, ErrorVector::Zero(P_last.rows()));
+}
+
+std::vector<RtsSmoothed> rts_backward(const std::vector<RtsSegment>& segments, const RtsSegment& tail,
+                                      const ErrorMatrix& P_last, const ErrorVector& eta_last) {
   RtsStore store(static_cast<int>(tail.M.rows()));
   store.reserve(segments.size());
   for (const RtsSegment& s : segments) store.push(s);
   std::vector<RtsSmoothed> out(segments.size() + 1);
-  rts_backward(store, tail, P_last, [&](size_t i, const ErrorVector& dx, const ErrorMatrix& P) {
+  rts_backward(store, tail, P_last, eta_last, [&](size_t i, const ErrorVector& dx, const ErrorMatrix& P) {
     out[i].dx = dx;
     out[i].P = P;
   });

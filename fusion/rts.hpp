@@ -85,6 +85,9 @@ class RtsInterval {
   /// Start the interval at output epoch a: Γ = V = P_a|a (the filter covariance after all of a's updates), μ = 0
   /// (eq. 12.14).
   void restart(const ErrorMatrix& P_a);
+  /// The same when the filter's error at a has a known non-zero conditional mean η_a = E[δx_a | Y_a] and P_a is
+  /// Var(δx_a | Y_a): μ = η_a (the smoother of a filter with consider states, docs/fusion.md §12.6, eq. 12.21).
+  void restart(const ErrorMatrix& P_a, const ErrorVector& eta_a);
   /// Prediction δx⁻ = Φ δx + w (w independent of δx_a): Γ ← Γ Φᵀ (eq. 12.15), Φ by its non-zeros.
   void predict(const ColumnSparse<ins::kMaxErrorDim>& Phi);
   /// The same with a dense Φ.
@@ -111,6 +114,9 @@ class RtsInterval {
   /// The segment of the interval a → b, P_b: the filter covariance at b after all its updates (eq. 12.20); the
   /// identity map if no step was predicted since restart().
   void close(const ErrorMatrix& P_b, RtsSegment& out) const;
+  /// The same when the error at b has the conditional mean η_b = E[δx_b | Y_b] and P_b = Var(δx_b | Y_b):
+  /// m = μ − M η_b (docs/fusion.md eq. 12.24).
+  void close(const ErrorMatrix& P_b, const ErrorVector& eta_b, RtsSegment& out) const;
   /// Number of predictions since restart().
   int steps() const { return steps_; }
   /// The current Γ, μ, V (tests).
@@ -184,9 +190,17 @@ struct RtsSmoothed {
 /// filtered solutions coincide, ŝ = 0). Calls visit(i, ŝ_i, P_s,i) for i = store.size() down to 0.
 void rts_backward(const RtsStore& store, const RtsSegment& tail, const ErrorMatrix& P_last,
                   const std::function<void(size_t, const ErrorVector&, const ErrorMatrix&)>& visit);
+/// The same when the error at the last step has the conditional mean eta_last = E[δx_N | Y_N] (the smoothed error
+/// there) and P_last = Var(δx_N | Y_N) (docs/fusion.md eq. 12.25).
+void rts_backward(const RtsStore& store, const RtsSegment& tail, const ErrorMatrix& P_last,
+                  const ErrorVector& eta_last,
+                  const std::function<void(size_t, const ErrorVector&, const ErrorMatrix&)>& visit);
 
 /// The same over segments held in a vector; returns one entry per output epoch (segments.size() + 1).
 std::vector<RtsSmoothed> rts_backward(const std::vector<RtsSegment>& segments, const RtsSegment& tail,
                                       const ErrorMatrix& P_last);
+/// The same with the conditional mean at the last step.
+std::vector<RtsSmoothed> rts_backward(const std::vector<RtsSegment>& segments, const RtsSegment& tail,
+                                      const ErrorMatrix& P_last, const ErrorVector& eta_last);
 
 }  // namespace pednav::fusion

@@ -334,7 +334,7 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
       "window,start_gps_week,start_gps_tow_s,duration_s,keep_sats,sats_left_min,sats_left_mean,sats_left_max,"
       "gnss_epochs_emptied,max_error_m,end_error_m,max_error_smoothed_m,end_error_smoothed_m,max_error_vs_run_m,"
       "end_error_vs_run_m,max_error_smoothed_vs_run_m,end_error_smoothed_vs_run_m\n";
-  // Without a smoothed nominal run (smoother off, or consider states) the smoothed columns stay empty.
+  // Without a smoothed nominal run (smoother off, or re-initialized) the smoothed columns stay empty.
   const bool has_s = res.has_smoothed;
   for (size_t k = 0; k < nw; ++k) {
     const auto& f = res.forward.per_window[k];

@@ -220,6 +220,93 @@ TEST_P(RtsLinearGaussian, EqualsBatchWeightedLeastSquares) {
 INSTANTIATE_TEST_SUITE_P(Decimation, RtsLinearGaussian,
                          ::testing::Values(std::pair{1, 1}, std::pair{2, 3}, std::pair{1, 13}));
 
+// Consider states (docs/fusion.md §12.6): the forward filter is a Schmidt–Kalman filter (state 3's gain row zeroed,
+// nominal never corrected there, P its exact Joseph covariance), so its error has a non-zero conditional mean. The
+// smoother runs on the Kalman-gain filter of the same problem, kept as a mean η of the Schmidt filter's error and its
+// covariance P_o (eqs. 12.21-12.25): Schmidt nominal + smoothed error must again be the batch WLS solution, and the
+// records built from the Schmidt filter's own P, S and K (what the engine did before §12.6) must not be.
+TEST(RtsConsiderStates, KalmanGainShadowOfASchmidtFilterEqualsBatchWeightedLeastSquares) {
+  constexpr int kConsider = 3;
+  const Problem p = make_problem(20240606u);
+  const auto [X, cov] = batch_wls(p);
+  for (const int every : {1, 3, 13}) {
+    VectorXd x = p.m0;  // the Schmidt filter's nominal
+    MatrixXd P = p.P0, Po = p.P0;
+    VectorXd eta = VectorXd::Zero(kN);
+    fusion::RtsInterval shadow(kN), naive(kN);
+    std::vector<fusion::RtsSegment> seg_shadow, seg_naive;
+    std::vector<int> outputs;
+    std::vector<VectorXd> nominal;
+    bool open = false;
+    double worst_fwd_gap = 0.0;  // |Schmidt nominal − Kalman filter mean|: the consider state must matter
+    for (int k = 0; k < kSteps; ++k) {
+      x = p.Phi * x;
+      P = p.Phi * P * p.Phi.transpose() + p.Q;
+      Po = p.Phi * Po * p.Phi.transpose() + p.Q;
+      eta = p.Phi * eta;  // eq. 12.22
+      shadow.predict(p.Phi);
+      naive.predict(p.Phi);
+      for (const Meas& m : p.meas) {
+        if (m.step != k + 1) continue;
+        const VectorXd r = m.y - m.H * x;
+        // Schmidt gain, exact (expanded Joseph) covariance.
+        const MatrixXd S = m.H * P * m.H.transpose() + m.R;
+        MatrixXd K = P * m.H.transpose() * S.inverse();
+        K.row(kConsider).setZero();
+        naive.update(m.H, r, Eigen::LDLT<MatrixXd>(S), K);
+        const MatrixXd IKH = MatrixXd::Identity(kN, kN) - K * m.H;
+        P = IKH * P * IKH.transpose() + K * m.R * K.transpose();
+        // Kalman gain on the same residual, relative to the mean η of the Schmidt filter's error (eq. 12.23).
+        const VectorXd nu = r - m.H * eta;
+        const MatrixXd So = m.H * Po * m.H.transpose() + m.R;
+        const MatrixXd Ko = Po * m.H.transpose() * So.inverse();
+        shadow.update(m.H, nu, Eigen::LDLT<MatrixXd>(So), Ko);
+        const MatrixXd IKHo = MatrixXd::Identity(kN, kN) - Ko * m.H;
+        Po = IKHo * Po * IKHo.transpose() + Ko * m.R * Ko.transpose();
+        eta += Ko * nu;
+        const VectorXd dx = K * r;  // fed back into the Schmidt nominal
+        x += dx;
+        eta -= dx;
+      }
+      const int step = k + 1;
+      if (step % every == 0) {
+        if (open) {
+          seg_shadow.emplace_back();
+          shadow.close(Po, eta, seg_shadow.back());
+          seg_naive.emplace_back();
+          naive.close(P, seg_naive.back());
+        }
+        shadow.restart(Po, eta);
+        naive.restart(P);
+        open = true;
+        outputs.push_back(step);
+        nominal.push_back(x);
+        worst_fwd_gap = std::max(worst_fwd_gap, eta.cwiseAbs().maxCoeff());
+      }
+    }
+    fusion::RtsSegment tail_shadow, tail_naive;
+    shadow.close(Po, eta, tail_shadow);
+    naive.close(P, tail_naive);
+    const auto sm = fusion::rts_backward(seg_shadow, tail_shadow, Po, eta);
+    const auto sm_naive = fusion::rts_backward(seg_naive, tail_naive, P);
+    ASSERT_EQ(sm.size(), outputs.size());
+    double worst_x = 0, worst_P = 0, worst_naive = 0;
+    for (size_t i = 0; i < outputs.size(); ++i) {
+      const int k = outputs[i];
+      worst_x = std::max(worst_x, (nominal[i] + sm[i].dx - X.segment(k * kN, kN)).cwiseAbs().maxCoeff());
+      worst_P = std::max(worst_P, (sm[i].P - cov.block(k * kN, k * kN, kN, kN)).cwiseAbs().maxCoeff());
+      worst_naive = std::max(worst_naive, (nominal[i] + sm_naive[i].dx - X.segment(k * kN, kN)).cwiseAbs().maxCoeff());
+    }
+    EXPECT_LT(worst_x, kTolState) << "outputs every " << every;
+    EXPECT_LT(worst_P, kTolCov) << "outputs every " << every;
+    EXPECT_GT(worst_fwd_gap, 1e3 * kTolState);  // the Schmidt filter is not the Kalman filter
+    EXPECT_GT(worst_naive, 1e3 * kTolState);    // nor is its RTS pass the smoother
+    std::printf("[ rts consider ] every %d: max |x_s − x_WLS| %.2e, |P_s − P_WLS| %.2e; Schmidt vs Kalman mean %.2e, "
+                "RTS on the Schmidt filter vs WLS %.2e\n",
+                every, worst_x, worst_P, worst_fwd_gap, worst_naive);
+  }
+}
+
 // Everything the engine does inside a mechanization step (docs/fusion.md §12.1, §12.4), on a random 9-state problem:
 // a dense random transition per step; ZUPT-like updates (rows without clock and drift columns), each followed by a
 // form-D-like re-expression δx_new = J δx_old, J = I + E_v B E_φᵀ, half of the time; clock and drift resets (fresh

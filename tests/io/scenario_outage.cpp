@@ -100,7 +100,7 @@ TEST_F(OutageCommand, FullOutageEmptiesEpochsAndDriftsFromTheRunWithoutOutage) {
   EXPECT_GT(r->forward_vs_run.max_error_m, kMinFullOutageDrift_m);
 }
 
-// Without a smoothed solution (here: the smoother switched off; the g-sensitivity consider states do the same) the
+// Without a smoothed solution (here: the smoother switched off; a re-initialized run does the same) the
 // smoothed columns of outages.csv are empty, not copies of the forward figures.
 TEST_F(OutageCommand, SmoothedColumnsAreEmptyWithoutASmoother) {
   io::RunConfig c = config();
