@@ -53,6 +53,12 @@ double yaw_n(const ins::NavState& x) {
 constexpr double kMinYawNeesWithout = 10.0;
 constexpr double kMaxYawNeesWith = 2.5;
 constexpr double kMaxSmoothedYawNeesWith = 3.0;
+// Smoothed horizontal position NEES (2 dof, mean 2 if consistent), seeds 5 / 6 / 7: without the states 25.3 / – / –,
+// with them 4.14 / 4.15 / 3.23; 4.37 / 4.46 / 3.74 with the smoother filter's errors-in-variables footprints left out
+// (too close to bound here: their effect is a common error of all runs, docs/consistency.md §3.11); restricted to the
+// INS block those footprints diverged (yaw NEES 41877 on seed 6), which the yaw bound catches.
+constexpr double kMinSmoothedPosNeesWithout = 10.0;
+constexpr double kMaxSmoothedPosNeesWith = 6.0;
 
 TEST(GSensitivity, ForwardYawIsConsistentOnlyWithTheGStates) {
   const io::ScenarioFile file = test::scenario_from_text(kGSensitiveWalk);
@@ -61,7 +67,7 @@ TEST(GSensitivity, ForwardYawIsConsistentOnlyWithTheGStates) {
   const auto& truth = s->truth.nav;
   const double rate = file.scenario.imu.rate_hz;
   const double t_walk = 70.0;  // after the static start and the heading initialization's first metres
-  double nees[2] = {0.0, 0.0}, nees_s[2] = {0.0, 0.0};
+  double nees[2] = {0.0, 0.0}, nees_s[2] = {0.0, 0.0}, pos_nees_s[2] = {0.0, 0.0};
   for (int on = 0; on < 2; ++on) {
     fusion::EngineOptions o = test::tc_default_options(file, *s);
     o.smoother_enabled = true;
@@ -84,6 +90,22 @@ TEST(GSensitivity, ForwardYawIsConsistentOnlyWithTheGStates) {
       }
       return n > 0 ? sum / n : 0.0;
     };
+    // Mean horizontal position NEES (2 dof) over the same epochs.
+    auto mean_pos_nees = [&](const std::vector<fusion::EpochOutput>& epochs) {
+      double sum = 0.0;
+      int n = 0;
+      for (const fusion::EpochOutput& e : epochs) {
+        if (e.t - truth.front().t < t_walk) continue;
+        const long i = std::lround((e.t - truth.front().t) * rate);
+        if (i < 0 || i >= static_cast<long>(truth.size()) || std::abs(truth[i].t - e.t) > 1e-6) continue;
+        const Geodetic llh = geodetic_from_ecef(truth[i].p_eb_e);
+        const Eigen::Vector2d d =
+            (R_e_n(llh.lat, llh.lon).transpose() * (e.nav.p_eb_e - truth[i].p_eb_e)).head<2>();
+        sum += d.dot(e.cov_p_n.topLeftCorner<2, 2>().ldlt().solve(d));
+        ++n;
+      }
+      return n > 0 ? sum / n : 0.0;
+    };
     int n = 0, n_s = 0;
     nees[on] = mean_yaw_nees(r->epochs, n);
     ASSERT_GT(n, 200);
@@ -92,14 +114,18 @@ TEST(GSensitivity, ForwardYawIsConsistentOnlyWithTheGStates) {
     ASSERT_FALSE(r->smoothed.empty()) << r->summary.smoother_message;
     nees_s[on] = mean_yaw_nees(r->smoothed, n_s);
     ASSERT_EQ(n_s, n);
+    pos_nees_s[on] = mean_pos_nees(r->smoothed);
     std::printf("[ g-sensitivity ] states %s: mean yaw NEES forward %.2f, smoothed %.2f over %d epochs, final yaw "
-                "sigma %.2f deg\n",
-                on ? "on " : "off", nees[on], nees_s[on], n, r->epochs.back().sd_yaw_rad * 57.29578);
+                "sigma %.2f deg; horizontal NEES forward %.2f, smoothed %.2f\n",
+                on ? "on " : "off", nees[on], nees_s[on], n, r->epochs.back().sd_yaw_rad * 57.29578,
+                mean_pos_nees(r->epochs), pos_nees_s[on]);
   }
   EXPECT_GT(nees[0], kMinYawNeesWithout);
   EXPECT_LT(nees[1], kMaxYawNeesWith);
   EXPECT_GT(nees_s[0], kMinYawNeesWithout);
   EXPECT_LT(nees_s[1], kMaxSmoothedYawNeesWith);
+  EXPECT_GT(pos_nees_s[0], kMinSmoothedPosNeesWithout);
+  EXPECT_LT(pos_nees_s[1], kMaxSmoothedPosNeesWith);
 }
 
 }  // namespace
