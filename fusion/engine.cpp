@@ -1358,6 +1358,7 @@ class Runner {
       double worst_w2 = threshold;
       for (int i = 0; i < a.size(); ++i) {
         const double w2 = a(i) * a(i) / Sinv(i, i);
+        if (records) (*records)[first_record + static_cast<size_t>(active[i])].w_final = a(i) / std::sqrt(Sinv(i, i));
         if (w2 > worst_w2) {
           worst_w2 = w2;
           worst = i;

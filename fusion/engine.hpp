@@ -213,6 +213,10 @@ struct GnssRowRecord {
   double w = 0.0;             ///< Baarda w-statistic in the first test of the epoch (all rows present)
   double mdb = 0.0;           ///< minimal detectable bias in that test: power 80 % at the configured probability [m or m/s]
   bool rejected = false;      ///< excluded by the iterative w-test
+  /// w in the last test the row took part in: for a rejected row the test that rejected it, for a used row the final
+  /// test (after every exclusion), so |w_final| ≤ the threshold for used rows. w of the first test also carries the
+  /// other rows' blunders (Baarda w-statistics are correlated); w_final does not (docs/fusion.md §6.1).
+  double w_final = 0.0;
 };
 
 struct EngineResult {
