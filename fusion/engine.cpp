@@ -199,31 +199,34 @@ class Filter {
     // subtracted totals change by < 2 % on the large ones, 5 % on the smallest, at about half the cost).
     eiv_dim_ = clock_blocks_.empty() ? layout_.dim() : clock_blocks_.front().offset;
     for (auto& t : eiv_) t.M.setZero(eiv_dim_, eiv_dim_);  // no noise footprint yet (also at a re-init)
-    // The same footprints for the smoother's Kalman-gain filter (consider states only), over the whole state: its
-    // gain also corrects the consider states, and the INS block alone is not stable under that gain (the footprint
-    // grew to 1e10 on the 1 °/s/g test walk).
-    eivo_ = eiv_;
-    for (auto& t : eivo_) t.M.setZero(layout_.dim(), layout_.dim());
     interval_.restart(P_);  // sized; the smoother's bookkeeping starts at the first output epoch (smoother_restart)
     // With consider states the smoother runs on the Kalman-gain filter of the same linearization (docs/fusion.md
-    // §12.6): its covariance starts as the filter's, its conditional mean of the error at zero.
+    // §12.6): its covariance starts as the filter's, its conditional mean of the error at zero. It has its own
+    // errors-in-variables footprints, over the whole state: its gain also corrects the consider states, and the INS
+    // block alone is not stable under that gain (the footprint grew to 1e10 on the 1 °/s/g test walk).
     shadow_ = consider_.count > 0 && o_.smoother_enabled;
+    eivo_.clear();
     if (shadow_) {
       Po_ = P_;
       eta_.setZero(P_.rows());
+      eivo_ = eiv_;
+      for (auto& t : eivo_) t.M.setZero(layout_.dim(), layout_.dim());
     }
   }
 
   // Replace the variance of a 3-state block (position [m], velocity [m/s]) by sigma² per axis, uncorrelated
   // (re-initialization).
   void set_block_sigma(const ins::Block& b, double sigma) {
-    for (ErrorMatrix* P : {&P_, &Po_}) {
-      if (P == &Po_ && !shadow_) continue;
-      P->middleRows<3>(b.offset).setZero();
-      P->middleCols<3>(b.offset).setZero();
-      P->block<3, 3>(b.offset, b.offset) = Eigen::Matrix3d::Identity() * sigma * sigma;
+    auto reset = [&](ErrorMatrix& P) {
+      P.middleRows<3>(b.offset).setZero();
+      P.middleCols<3>(b.offset).setZero();
+      P.block<3, 3>(b.offset, b.offset) = Eigen::Matrix3d::Identity() * sigma * sigma;
+    };
+    reset(P_);
+    if (shadow_) {
+      reset(Po_);
+      eta_.segment<3>(b.offset).setZero();
     }
-    if (shadow_) eta_.segment<3>(b.offset).setZero();
   }
 
   // Mechanize one (already bias-corrected) increment and propagate the covariance.
@@ -297,10 +300,7 @@ class Filter {
     double eiv_bias[kMaxEivTerms];
     const bool ok = joseph_update(P_, H, r, R, dx, [&](const auto& S_ldlt, const auto& K) {
       if (recording_ && !shadow_) interval_.update(H, r, S_ldlt, K);
-      if (eiv_.empty()) return;
-      int nz[ins::kMaxErrorDim];
-      const int n_nz = nonzero_columns(H, nz);
-      for (size_t j = 0; j < eiv_.size(); ++j) eiv_bias[j] = eiv_update(eiv_[j].M, H, nz, n_nz, S_ldlt, K);
+      eiv_update_all(eiv_, H, S_ldlt, K, eiv_bias);
     }, consider_);
     if (!ok) return false;
     if (shadow_) {
@@ -314,28 +314,15 @@ class Filter {
       double eivo_bias[kMaxEivTerms];
       if (joseph_update(Po_, H, nu, R, dxo, [&](const auto& So_ldlt, const auto& Ko) {
             if (recording_) interval_.update(H, nu, So_ldlt, Ko);
-            if (eivo_.empty()) return;
-            int nz[ins::kMaxErrorDim];
-            const int n_nz = nonzero_columns(H, nz);
-            for (size_t j = 0; j < eivo_.size(); ++j) {
-              eivo_bias[j] = eiv_update(eivo_[j].M, H, nz, n_nz, So_ldlt, Ko);
-            }
+            eiv_update_all(eivo_, H, So_ldlt, Ko, eivo_bias);
           })) {
-        for (size_t j = 0; j < eivo_.size(); ++j) {
-          dxo(eivo_[j].state) -= eivo_bias[j];
-          eivo_[j].total += eivo_bias[j];
-          if (recording_) interval_.shift_mean(eivo_[j].state, -eivo_bias[j]);  // eq. E.6 for the smoother's filter
-        }
+        eiv_subtract(eivo_, eivo_bias, dxo, recording_);
         eta_ += dxo;
       }
     }
-    for (size_t j = 0; j < eiv_.size(); ++j) {
-      dx(eiv_[j].state) -= eiv_bias[j];
-      eiv_[j].total += eiv_bias[j];
-      // The smoother conditions on the same residual: without this its scale estimate at the interval's start would
-      // take the subtraction back (docs/consistency.md eq. E.6). With consider states η carries it (eq. 12.23).
-      if (recording_ && !shadow_) interval_.shift_mean(eiv_[j].state, -eiv_bias[j]);
-    }
+    // The smoother's interval conditions on the forward filter's residual unless the Kalman-gain filter runs (then η
+    // carries the subtraction, eq. 12.23).
+    eiv_subtract(eiv_, eiv_bias, dx, recording_ && !shadow_);
     apply(dx);
     if (shadow_) eta_ -= dx;  // the nominal moved by dx: the error's conditional mean moves by −dx (eq. 12.23)
     return true;
@@ -376,8 +363,6 @@ class Filter {
     reset = true;
     return lru;
   }
-  /// Whether some states are consider states (never corrected; Schmidt–Kalman).
-  bool has_consider_states() const { return consider_.count > 0; }
   /// First state of the g-sensitivity block (column-major G_g), −1 without it.
   int g_sensitivity_offset() const { return g_sens_offset_; }
   /// State index of multipath slot `slot`; its nominal value u (closed loop: normally 0 after each update, decayed).
@@ -414,13 +399,16 @@ class Filter {
   // State i restarted as a fresh variable of the given variance, independent of everything before (clock, drift,
   // multipath slot): in P, in the smoother's Kalman-gain filter and in the smoother's interval (eq. 12.19).
   void restart_variable(int i, double variance) {
-    for (ErrorMatrix* P : {&P_, &Po_}) {
-      if (P == &Po_ && !shadow_) continue;
-      P->row(i).setZero();
-      P->col(i).setZero();
-      (*P)(i, i) = variance;
+    auto reset = [&](ErrorMatrix& P) {
+      P.row(i).setZero();
+      P.col(i).setZero();
+      P(i, i) = variance;
+    };
+    reset(P_);
+    if (shadow_) {
+      reset(Po_);
+      eta_(i) = 0.0;
     }
-    if (shadow_) eta_(i) = 0.0;
     if (recording_) interval_.restart_state(i);
   }
 
@@ -601,6 +589,25 @@ class Filter {
         t.M.block<3, 3>(u.block_offset, u.block_offset).noalias() +=
             (P(t.state, u.state) * psd * dt) * (g * g.transpose());
       }
+    }
+  }
+
+  // eiv_update for every term of `terms` (the forward filter's or the smoother's Kalman-gain filter's) into bias[].
+  template <typename MatH, typename Ldlt, typename MatK>
+  void eiv_update_all(std::vector<EivTerm>& terms, const MatH& H, const Ldlt& S_ldlt, const MatK& K, double* bias) {
+    if (terms.empty()) return;
+    int nz[ins::kMaxErrorDim];
+    const int n_nz = nonzero_columns(H, nz);
+    for (size_t j = 0; j < terms.size(); ++j) bias[j] = eiv_update(terms[j].M, H, nz, n_nz, S_ldlt, K);
+  }
+  // Subtract the mean noise parts from the correction dx (docs/consistency.md eq. E.4) and, with shift_interval, move
+  // the smoother interval's mean by the same amount: without that its scale estimate at the interval's start would
+  // take the subtraction back (eq. E.6).
+  void eiv_subtract(std::vector<EivTerm>& terms, const double* bias, ErrorVector& dx, bool shift_interval) {
+    for (size_t j = 0; j < terms.size(); ++j) {
+      dx(terms[j].state) -= bias[j];
+      terms[j].total += bias[j];
+      if (shift_interval) interval_.shift_mean(terms[j].state, -bias[j]);
     }
   }
 

@@ -109,11 +109,13 @@ void RtsInterval::restart_state(int i) {
   Gamma_.col(i).setZero();
 }
 
-void RtsInterval::close(const ErrorMatrix& P_b, RtsSegment& out) const {
-  close(P_b, ErrorVector::Zero(Gamma_.rows()), out);
-}
+void RtsInterval::close(const ErrorMatrix& P_b, RtsSegment& out) const { close(P_b, nullptr, out); }
 
 void RtsInterval::close(const ErrorMatrix& P_b, const ErrorVector& eta_b, RtsSegment& out) const {
+  close(P_b, &eta_b, out);
+}
+
+void RtsInterval::close(const ErrorMatrix& P_b, const ErrorVector* eta_b, RtsSegment& out) const {
   const int n = static_cast<int>(Gamma_.rows());
   if (steps_ == 0) {  // b = a: the identity map (what the per-step composition gives for no steps)
     out.M.setIdentity(n, n);
@@ -130,7 +132,7 @@ void RtsInterval::close(const ErrorMatrix& P_b, const ErrorVector& eta_b, RtsSeg
   out.M = Mt.transpose();
   // E[δx_a | δx_b, Y_b] = μ + M (δx_b − η_b) (eq. 12.24; η_b = 0 for a Kalman gain, eq. 12.20).
   out.m = mu_;
-  out.m.noalias() -= out.M * eta_b;
+  if (eta_b) out.m.noalias() -= out.M * *eta_b;
   out.S = V_;  // S = Var(δx_a | δx_b, Y_b) = V − M Γᵀ (eq. 12.20)
   out.S.noalias() -= out.M * Gamma_.transpose();
   out.S = 0.5 * (out.S + out.S.transpose()).eval();

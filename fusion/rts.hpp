@@ -125,6 +125,9 @@ class RtsInterval {
   const ErrorMatrix& var() const { return V_; }
 
  private:
+  // The two close() overloads; eta_b null: zero conditional mean (no product).
+  void close(const ErrorMatrix& P_b, const ErrorVector* eta_b, RtsSegment& out) const;
+
   ErrorMatrix Gamma_, V_, tmp_;
   ErrorVector mu_;
   int steps_ = 0;
