@@ -63,10 +63,17 @@ std::vector<int> select_kept_satellites(std::vector<SatCandidate> candidates, in
 WindowStats window_stats(const WindowErrors& w) {
   WindowStats s;
   s.samples = static_cast<int>(w.horizontal_m.size());
-  for (double e : w.horizontal_m) s.max_m = std::max(s.max_m, e);
+  const bool have_sigma = w.sigma_horizontal_m.size() == w.horizontal_m.size();
+  for (size_t i = 0; i < w.horizontal_m.size(); ++i) {
+    if (i == 0 || w.horizontal_m[i] > s.max_m) {
+      s.max_m = w.horizontal_m[i];
+      if (have_sigma) s.sigma_at_max_m = w.sigma_horizontal_m[i];
+    }
+  }
   if (s.samples > 0) {
     s.end_m = w.horizontal_m.back();
     s.end_t_since_s = w.t_since_s.back();
+    if (have_sigma) s.end_sigma_m = w.sigma_horizontal_m.back();
   }
   return s;
 }

@@ -4,6 +4,7 @@
 // Pure functions: no I/O.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,8 @@ struct WindowErrors {
   OutageWindow window;
   std::vector<double> t_since_s;     ///< time since the outage started [s], increasing
   std::vector<double> horizontal_m;  ///< horizontal error [m] at those times
+  /// The solution's own horizontal 1σ √(P_nn + P_ee) [m] at those times; empty when the caller has none.
+  std::vector<double> sigma_horizontal_m;
 };
 
 /// Per-window figures for outages.csv.
@@ -56,6 +59,9 @@ struct WindowStats {
   double max_m = 0.0;       ///< maximum horizontal error inside the window [m]
   double end_m = 0.0;       ///< horizontal error at the last sample of the window [m]
   double end_t_since_s = 0.0;
+  /// The solution's horizontal 1σ at the sample of the maximum error and at the last sample [m]; NaN without σ.
+  double sigma_at_max_m = NAN;
+  double end_sigma_m = NAN;
 };
 
 /// Maximum and end error of one window (samples == 0 when the window has no sample).

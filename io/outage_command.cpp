@@ -111,8 +111,12 @@ eval::Trajectory to_trajectory(const std::vector<fusion::EpochOutput>& epochs) {
 Expected<eval::WindowErrors> window_errors(const std::vector<fusion::EpochOutput>& epochs,
                                            const eval::Trajectory& reference, const eval::OutageWindow& w) {
   eval::Trajectory sol;
+  std::map<int64_t, double> sigma_h_m;  // solution time [GPST ns] -> its horizontal 1σ √(P_nn + P_ee)
   for (const auto& e : epochs) {
-    if (!(e.t < w.start) && !(w.end() < e.t)) sol.points.push_back({e.t, e.nav.p_eb_e});
+    if (!(e.t < w.start) && !(w.end() < e.t)) {
+      sol.points.push_back({e.t, e.nav.p_eb_e});
+      sigma_h_m[e.t.ns()] = std::sqrt(std::max(0.0, e.cov_p_n(0, 0) + e.cov_p_n(1, 1)));
+    }
   }
   eval::WindowErrors we;
   we.window = w;
@@ -122,6 +126,8 @@ Expected<eval::WindowErrors> window_errors(const std::vector<fusion::EpochOutput
   for (const auto& e : ev->errors) {
     we.t_since_s.push_back(e.t - w.start);
     we.horizontal_m.push_back(e.horizontal_m);
+    const auto it = sigma_h_m.find(e.t.ns());
+    we.sigma_horizontal_m.push_back(it == sigma_h_m.end() ? NAN : it->second);
   }
   return we;
 }
@@ -333,7 +339,8 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
   std::string csv =
       "window,start_gps_week,start_gps_tow_s,duration_s,keep_sats,sats_left_min,sats_left_mean,sats_left_max,"
       "gnss_epochs_emptied,max_error_m,end_error_m,max_error_smoothed_m,end_error_smoothed_m,max_error_vs_run_m,"
-      "end_error_vs_run_m,max_error_smoothed_vs_run_m,end_error_smoothed_vs_run_m\n";
+      "end_error_vs_run_m,max_error_smoothed_vs_run_m,end_error_smoothed_vs_run_m,"
+      "sigma_at_max_error_m,end_sigma_m,sigma_at_max_error_smoothed_m,end_sigma_smoothed_m\n";
   // Without a smoothed nominal run (smoother off, or re-initialized) the smoothed columns stay empty.
   const bool has_s = res.has_smoothed;
   for (size_t k = 0; k < nw; ++k) {
@@ -341,13 +348,16 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
     const auto& s = res.smoothed.per_window[k];
     const auto& fr = res.forward_vs_run.per_window[k];
     const auto& sr = res.smoothed_vs_run.per_window[k];
-    csv += fmt::format("{},{},{:.3f},{:.3f},{},{},{:.2f},{},{},{},{},{},{},{},{},{},{}\n", k + 1,
+    auto sig = [](double v, bool have) { return fmt_opt(v, have && std::isfinite(v)); };
+    csv += fmt::format("{},{},{:.3f},{:.3f},{},{},{:.2f},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", k + 1,
                        res.windows[k].start.week(), res.windows[k].start.tow_s(), res.windows[k].duration_s,
                        a.keep_sats, res.sats_kept_min[k], res.sats_kept_mean[k], res.sats_kept_max[k],
                        res.epochs_masked[k], fmt_opt(f.max_m, f.samples > 0), fmt_opt(f.end_m, f.samples > 0),
                        fmt_opt(s.max_m, has_s && s.samples > 0), fmt_opt(s.end_m, has_s && s.samples > 0),
                        fmt_opt(fr.max_m, fr.samples > 0), fmt_opt(fr.end_m, fr.samples > 0),
-                       fmt_opt(sr.max_m, has_s && sr.samples > 0), fmt_opt(sr.end_m, has_s && sr.samples > 0));
+                       fmt_opt(sr.max_m, has_s && sr.samples > 0), fmt_opt(sr.end_m, has_s && sr.samples > 0),
+                       sig(f.sigma_at_max_m, f.samples > 0), sig(f.end_sigma_m, f.samples > 0),
+                       sig(s.sigma_at_max_m, has_s && s.samples > 0), sig(s.end_sigma_m, has_s && s.samples > 0));
   }
   if (auto ok = write_file_atomic((out / "outages.csv").string(), csv); !ok) return ok.error();
   if (a.write_runs) {
@@ -435,6 +445,10 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
                   {"max_error_m", res.forward.per_window[k].max_m},
                   {"end_error_m", res.forward.per_window[k].end_m},
                   {"sats_left_mean", res.sats_kept_mean[k]}});
+    // The forward filter's own horizontal 1σ beside its errors (absent when the solution carries no covariance).
+    const auto& f = res.forward.per_window[k];
+    if (std::isfinite(f.sigma_at_max_m)) wl.back()["sigma_at_max_error_m"] = f.sigma_at_max_m;
+    if (std::isfinite(f.end_sigma_m)) wl.back()["end_sigma_m"] = f.end_sigma_m;
   }
   j["window_list"] = wl;
   j["config"] = c.source_file;

@@ -270,8 +270,9 @@ void outage_section(Html& h, const fs::path& d, const fs::path& run_dir) {
   }
   if (auto w = read_csv_table((d / "outages.csv").string())) {
     std::vector<std::vector<std::string>> rows;
-    const std::vector<std::string> cols{"window", "start_gps_tow_s", "sats_left_mean", "max_error_m", "end_error_m",
-                                        "max_error_smoothed_m", "end_error_smoothed_m"};
+    const std::vector<std::string> cols{"window",        "start_gps_tow_s",      "sats_left_mean",
+                                        "max_error_m",   "sigma_at_max_error_m", "end_error_m",
+                                        "end_sigma_m",   "max_error_smoothed_m", "end_error_smoothed_m"};
     for (size_t i = 0; i < w->rows; ++i) {
       std::vector<std::string> r;
       for (const auto& c : cols) {

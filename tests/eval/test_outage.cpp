@@ -103,6 +103,24 @@ TEST(OutageErrors, WindowStatsAndRmsAcrossWindows) {
   EXPECT_NEAR(r2.rms_m[4], 0.4, kTol_m);
 }
 
+// The solution's own σ is reported at the sample of the largest error and at the window's end; without σ
+// (or with a σ series of another length) both stay NaN.
+TEST(OutageErrors, WindowStatsCarryTheSigmaAtTheMaximumAndAtTheEnd) {
+  WindowErrors w;
+  w.t_since_s = {0.0, 1.0, 2.0, 3.0};
+  w.horizontal_m = {0.5, 2.5, 1.0, 0.7};
+  const WindowStats none = window_stats(w);
+  EXPECT_TRUE(std::isnan(none.sigma_at_max_m));
+  EXPECT_TRUE(std::isnan(none.end_sigma_m));
+  w.sigma_horizontal_m = {0.4, 1.6, 1.9, 2.2};
+  const WindowStats s = window_stats(w);
+  EXPECT_NEAR(s.max_m, 2.5, kTol_m);
+  EXPECT_NEAR(s.sigma_at_max_m, 1.6, kTol_m) << "sigma of the sample with the largest error, not the largest sigma";
+  EXPECT_NEAR(s.end_sigma_m, 2.2, kTol_m);
+  w.sigma_horizontal_m.pop_back();
+  EXPECT_TRUE(std::isnan(window_stats(w).sigma_at_max_m)) << "a sigma series that does not match is not used";
+}
+
 TEST(OutageErrors, EmpiricalCdf) {
   const Cdf c = empirical_cdf({3.0, 1.0, 2.0, 4.0});
   EXPECT_THAT(c.value, ElementsAre(1.0, 2.0, 3.0, 4.0));

@@ -76,7 +76,17 @@ TEST_F(OutageCommand, PartialKeepsAtMostNSatellitesAndWritesTheDesignOutputs) {
   EXPECT_THAT(rms, HasSubstr("\n10,"));
   const std::string csv = test::read_text(a.out_dir + "/outages.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), kWindows + 1);
+  EXPECT_THAT(csv.substr(0, csv.find('\n')),
+              ::testing::EndsWith(",sigma_at_max_error_m,end_sigma_m,sigma_at_max_error_smoothed_m,end_sigma_smoothed_m"));
   auto j = nlohmann::json::parse(test::read_text(a.out_dir + "/summary.json"));
+  // The forward filter's own horizontal σ beside its errors: positive, bounded, and the solution's σ rather than a
+  // copy of the error.
+  for (const auto& w : j["window_list"]) {
+    ASSERT_TRUE(w.contains("end_sigma_m") && w.contains("sigma_at_max_error_m")) << w.dump();
+    EXPECT_GT(w["end_sigma_m"].get<double>(), 0.0);
+    EXPECT_LT(w["end_sigma_m"].get<double>(), 3.0 * kMaxPartialError_m);
+    EXPECT_NE(w["end_sigma_m"].get<double>(), w["end_error_m"].get<double>());
+  }
   for (const char* k : {"windows", "duration_s", "keep_sats", "max_error_m", "rms_at_end_m"}) {
     EXPECT_TRUE(j.contains(k)) << k;
   }
@@ -118,9 +128,10 @@ TEST_F(OutageCommand, SmoothedColumnsAreEmptyWithoutASmoother) {
     if (e == std::string::npos) e = row.size();
     cells.push_back(row.substr(b, e - b));
   }
-  ASSERT_EQ(cells.size(), 17u) << row;
+  ASSERT_EQ(cells.size(), 21u) << row;
   EXPECT_FALSE(cells[9].empty()) << "forward max error";
-  for (int i : {11, 12, 15, 16}) EXPECT_TRUE(cells[i].empty()) << "column " << i << " of " << row;
+  EXPECT_FALSE(cells[17].empty()) << "forward sigma at the max error";
+  for (int i : {11, 12, 15, 16, 19, 20}) EXPECT_TRUE(cells[i].empty()) << "column " << i << " of " << row;
 }
 
 TEST_F(OutageCommand, BadOptionsAreNamed) {
