@@ -56,6 +56,7 @@ struct McOptions {
   bool no_scale_states = false;    ///< no scale-factor states (the mode-ins default; tc has accelerometer ones)
   bool gauss_markov_bias = false;  ///< Gauss-Markov bias model (the mode-ins default; tc uses the random walk)
   bool saturation_repair = true;   ///< reconstruct clipped IMU runs (`saturation: {repair: false}` to switch off)
+  bool no_doppler = false;             ///< no Doppler rows (`gnss: {use_doppler: false}`)
   bool foot_antenna_velocity = false;  ///< Doppler rows with the foot's own velocity (`antenna: {velocity_model: foot}`)
   std::optional<bool> scale_bias_compensation;  ///< scale_factors.bias_compensation (unset: the default)
   double elevation_weight = std::numeric_limits<double>::quiet_NaN();  ///< gnss.elevation_weight (NaN: the default)
@@ -150,6 +151,7 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
   if (mo.accel_scale_states) o.estimate_gyro_scale_factors = false;
   if (mo.bias_random_walk) o.bias_random_walk = true;
   o.repair_saturation = mo.saturation_repair;
+  if (mo.no_doppler) o.use_doppler = false;
   if (mo.foot_antenna_velocity) o.antenna_velocity_model = fusion::AntennaVelocityModel::kFoot;
   if (mo.multipath_states) {
     // The filter's multipath model = the simulator's (docs/consistency.md §3).
@@ -467,6 +469,7 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
       ->excludes("--bias-random-walk");
   cmd->add_flag("!--no-saturation-repair", mo->saturation_repair,
                 "Integrate clipped IMU samples as they are (`saturation: {repair: false}`)");
+  cmd->add_flag("--no-doppler", mo->no_doppler, "Code rows only, no Doppler rows (`gnss: {use_doppler: false}`)");
   cmd->add_flag("--foot-antenna-velocity", mo->foot_antenna_velocity,
                 "Doppler rows predict the antenna velocity as the foot's own (`antenna: {velocity_model: foot}`; "
                 "default: the stride-average foot velocity)");

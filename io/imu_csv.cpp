@@ -39,6 +39,10 @@ bool gyro_is_increment(const std::string& u) { return u == "rad" || u == "deg"; 
 bool accel_is_increment(const std::string& u) { return u == "mps"; }
 
 // Which accelerometer unit setting would make the rest |f| equal to g.
+// | |f_rest| - 9.8 | above which a log that passes the unit check still gets a warning [m/s^2] (~2σ of a
+// Crista-class accelerometer's turn-on bias and scale error).
+constexpr double kRestWarning_mps2 = 0.6;
+
 std::string accel_unit_hint(double f_rest, const ImuFormat& fmt) {
   if (std::abs(f_rest - 1.0) < 0.1 && fmt.accel_unit != "g") return "accel.unit is probably g (|f| at rest is about 1)";
   if (std::abs(f_rest - kG0 * kG0) < 6.0 && fmt.accel_unit == "g")
@@ -279,6 +283,12 @@ Expected<ImuLog> parse_imu_csv(const char* data, size_t size, const std::string&
   if (fmt.gyro_unit == "rad_per_s" && rep.max_gyro_norm_radps > 40.0) {
     return make_error(name + ": angular rate reaches " + num(rep.max_gyro_norm_radps, "%.4g") +
                       " rad/s, beyond any foot IMU: gyro.unit is probably deg_per_s, not rad_per_s");
+  }
+  if (const double dev = std::abs(rep.rest_f_norm_mps2 - kG0); dev > kRestWarning_mps2) {
+    rep.warnings.push_back("specific force at rest is " + num(rep.rest_f_norm_mps2, "%.4g") + " m/s^2 (" +
+                           num(dev, "%.2f") + " from 9.81; stillest window at " +
+                           num(rep.rest_window_start_s, "%.2f") +
+                           " s): a large accelerometer bias or scale-factor error, or accel.unit/columns are wrong");
   }
   if (rep.truncated_rows)
     rep.warnings.push_back("the last line (" + name + ":" + std::to_string(line) +

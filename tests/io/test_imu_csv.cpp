@@ -156,6 +156,25 @@ TEST(ImuCsv, OutOfOrderTimeIsAnErrorWithFileAndLine) {
   EXPECT_THAT(log.error().message, HasSubstr("imu.csv:7: time 0.035000 s is not after the previous 0.040000 s"));
 }
 
+// A Crista-class accelerometer's 30 mg turn-on bias + 1 % scale error can put |f| at rest 0.7 m/s^2 from 9.81
+// (forest_walk seed 11: 10.52): that log loads, with a warning naming the value; a unit mistake does not.
+TEST(ImuCsv, LargeAccelerometerBiasWarnsButAUnitMistakeFails) {
+  auto biased = parse(still_csv(200, 10.52), basic());
+  ASSERT_TRUE(biased) << biased.error().message;
+  std::string all;
+  for (const auto& w : biased->report.warnings) all += w + "\n";
+  EXPECT_THAT(all, HasSubstr("specific force at rest is 10.52 m/s^2 (0.71 from 9.81"));
+  auto nominal = parse(still_csv(200, 9.9), basic());
+  ASSERT_TRUE(nominal);
+  for (const auto& w : nominal->report.warnings) EXPECT_THAT(w, ::testing::Not(HasSubstr("specific force"))) << w;
+  auto ft = parse(still_csv(200, 32.17), basic());  // ft/s^2 read as m/s^2
+  ASSERT_FALSE(ft);
+  EXPECT_THAT(ft.error().message, HasSubstr("specific force at rest is 32.17"));
+  ImuFormat tight = basic();
+  tight.rest_tolerance_mps2 = 0.5;
+  EXPECT_FALSE(parse(still_csv(200, 10.52), tight)) << "the configured tolerance is the limit";
+}
+
 TEST(ImuCsv, UnitMistakesNameTheSettingThatIsProbablyWrong) {
   auto g_as_mps2 = parse(still_csv(200, 1.0), basic());
   ASSERT_FALSE(g_as_mps2);
