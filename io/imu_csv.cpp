@@ -38,11 +38,11 @@ double accel_scale(const std::string& u) { return u == "g" ? kG0 : 1.0; }
 bool gyro_is_increment(const std::string& u) { return u == "rad" || u == "deg"; }
 bool accel_is_increment(const std::string& u) { return u == "mps"; }
 
-// Which accelerometer unit setting would make the rest |f| equal to g.
 // | |f_rest| - 9.8 | above which a log that passes the unit check still gets a warning [m/s^2] (~2σ of a
 // Crista-class accelerometer's turn-on bias and scale error).
 constexpr double kRestWarning_mps2 = 0.6;
 
+// Which accelerometer unit setting would make the rest |f| equal to g.
 std::string accel_unit_hint(double f_rest, const ImuFormat& fmt) {
   if (std::abs(f_rest - 1.0) < 0.1 && fmt.accel_unit != "g") return "accel.unit is probably g (|f| at rest is about 1)";
   if (std::abs(f_rest - kG0 * kG0) < 6.0 && fmt.accel_unit == "g")
