@@ -42,8 +42,8 @@ struct ImuFormat {
   double gap_factor = 1.8;        ///< a gap is a time step > gap_factor x median step
   /// Allowed | |f_rest| - 9.8 | before the unit check fails [m/s^2]. Every unit mistake moves |f_rest| by a factor
   /// (g: 1/9.8, ft/s^2: 3.28, mg or cm/s^2: ~100); a MEMS accelerometer's own turn-on bias and scale error do not
-  /// (Crista-class 30 mg + 1 %: σ ≈ 0.31 m/s^2, so 0.6 rejected about 1 IMU in 20). Between
-  /// kRestWarning_mps2 and this limit the log loads with a warning.
+  /// (Crista-class 30 mg + 1 %: σ ≈ 0.31 m/s^2, so 0.6 rejected about 1 IMU in 20). Between 0.6 m/s^2
+  /// (kRestWarning_mps2, imu_csv.cpp) and this limit the log loads with a warning.
   double rest_tolerance_mps2 = 2.0;
 
   /// Every problem at once, empty when valid.

@@ -162,7 +162,8 @@ std::vector<SolutionRow> solution_rows(const std::vector<fusion::EpochOutput>& e
   return rows;
 }
 
-std::string fmt_opt(double v, bool have) { return have ? fmt::format("{:.3f}", v) : ""; }
+// A CSV cell: the value, or empty when there is none (not `have`, or not finite).
+std::string fmt_opt(double v, bool have) { return have && std::isfinite(v) ? fmt::format("{:.3f}", v) : ""; }
 
 }  // namespace
 
@@ -348,7 +349,6 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
     const auto& s = res.smoothed.per_window[k];
     const auto& fr = res.forward_vs_run.per_window[k];
     const auto& sr = res.smoothed_vs_run.per_window[k];
-    auto sig = [](double v, bool have) { return fmt_opt(v, have && std::isfinite(v)); };
     csv += fmt::format("{},{},{:.3f},{:.3f},{},{},{:.2f},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", k + 1,
                        res.windows[k].start.week(), res.windows[k].start.tow_s(), res.windows[k].duration_s,
                        a.keep_sats, res.sats_kept_min[k], res.sats_kept_mean[k], res.sats_kept_max[k],
@@ -356,8 +356,9 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
                        fmt_opt(s.max_m, has_s && s.samples > 0), fmt_opt(s.end_m, has_s && s.samples > 0),
                        fmt_opt(fr.max_m, fr.samples > 0), fmt_opt(fr.end_m, fr.samples > 0),
                        fmt_opt(sr.max_m, has_s && sr.samples > 0), fmt_opt(sr.end_m, has_s && sr.samples > 0),
-                       sig(f.sigma_at_max_m, f.samples > 0), sig(f.end_sigma_m, f.samples > 0),
-                       sig(s.sigma_at_max_m, has_s && s.samples > 0), sig(s.end_sigma_m, has_s && s.samples > 0));
+                       fmt_opt(f.sigma_at_max_m, f.samples > 0), fmt_opt(f.end_sigma_m, f.samples > 0),
+                       fmt_opt(s.sigma_at_max_m, has_s && s.samples > 0),
+                       fmt_opt(s.end_sigma_m, has_s && s.samples > 0));
   }
   if (auto ok = write_file_atomic((out / "outages.csv").string(), csv); !ok) return ok.error();
   if (a.write_runs) {
@@ -389,8 +390,8 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
   }
   std::string rcsv = "t_since_outage_s,rms_horizontal_m,n_windows,rms_horizontal_smoothed_m,n_windows_smoothed\n";
   for (const auto& [t, r] : rows) {
-    rcsv += fmt::format("{},{},{},{},{}\n", t, fmt_opt(r[0], std::isfinite(r[0])), static_cast<int>(r[1]),
-                        fmt_opt(r[2], std::isfinite(r[2])), static_cast<int>(r[3]));
+    rcsv += fmt::format("{},{},{},{},{}\n", t, fmt_opt(r[0], true), static_cast<int>(r[1]),
+                        fmt_opt(r[2], true), static_cast<int>(r[3]));
   }
   if (auto ok = write_file_atomic((out / "rms_vs_time.csv").string(), rcsv); !ok) return ok.error();
 
