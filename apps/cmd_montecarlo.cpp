@@ -29,6 +29,7 @@
 #include "io/log.hpp"
 #include "io/run_command.hpp"
 #include "io/scenario_config.hpp"
+#include "io/simulate_command.hpp"
 #include "sim/gnss_sim.hpp"
 #include "sim/simulator.hpp"
 
@@ -129,20 +130,15 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
   c.smoother_enabled = mo.smoother;
   if (mo.no_scale_states) c.scale_factors.states = false;
   if (mo.gauss_markov_bias) c.bias.model = "gauss_markov";
-  if (mo.receiver_weights) {  // the filter's code and Doppler weights = the simulated receiver (docs/consistency.md §3.8)
-    const gnss::WeightModel w = sim::receiver_weight_model(sc.gnss);
-    c.gnss.cn0_ref_dbhz = w.cn0_ref_dbhz;
-    c.gnss.code_sigma_zenith_m = w.code_sigma_zenith_m;
-    c.gnss.doppler_sigma_zenith_mps = w.doppler_sigma_zenith_mps;
-    c.gnss.elevation_weight = w.elevation_weight;
-    c.gnss.code_squaring_loss = w.code_squaring_loss;
-  }
-  // The gyro's g-sensitivity σ as a data sheet states it = the simulated one: the filter gets its 9 G states.
-  if (mo.g_sensitivity_states) c.imu.spec.gyro_g_sensitivity = sc.imu.gyro_g_sensitivity_sigma;
-  if (mo.scenario_lever_arm) {  // what a user measures on the walker: antenna height over the foot, foot beside the line
-    c.antenna.lever_arm_ned_m = Eigen::Vector3d(0.0, 0.0, -(sc.gnss.antenna_height_m - sc.gait.imu_height_m));
-    c.antenna.lever_arm_heading_m = Eigen::Vector3d(0.0, -sc.gait.foot_offset_m, 0.0);
-  }
+  // The simulated sensors' own models where the flags ask for them (what config_datasheet.yaml of pednav simulate
+  // has): receiver weights (docs/consistency.md §3.8), walker lever arm (docs/fusion.md §14), the gyro's
+  // g-sensitivity σ (its 9 consider states, docs/error_state.md §5), code multipath σ/τ (docs/consistency.md §3).
+  io::DataSheetParts parts;
+  parts.receiver_weights = mo.receiver_weights;
+  parts.lever_arm = mo.scenario_lever_arm;
+  parts.g_sensitivity = mo.g_sensitivity_states;
+  parts.multipath = mo.multipath_states;
+  io::apply_data_sheet(sc, parts, c);
   if (!std::isnan(mo.elevation_weight)) c.gnss.elevation_weight = mo.elevation_weight;
   if (mo.scale_bias_compensation) c.scale_factors.bias_compensation = *mo.scale_bias_compensation;
   fusion::EngineOptions o = io::engine_options(c);
@@ -153,12 +149,6 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
   o.repair_saturation = mo.saturation_repair;
   if (mo.no_doppler) o.use_doppler = false;
   if (mo.foot_antenna_velocity) o.antenna_velocity_model = fusion::AntennaVelocityModel::kFoot;
-  if (mo.multipath_states) {
-    // The filter's multipath model = the simulator's (docs/consistency.md §3).
-    o.multipath_sigma_m = sc.gnss.multipath_sigma_m;
-    o.multipath_tau_s = sc.gnss.multipath_tau_s;
-    o.multipath_cn0_ref_dbhz = sc.gnss.multipath_cn0_ref_dbhz;
-  }
   if (mo.white_code) o.multipath_sigma_m = 0.0;
   o.zupt_updates = mo.zupt_updates;
   o.step_velocity.enabled = mo.step_velocity;
@@ -450,7 +440,8 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
   cmd->add_flag("!--no-smoother", mo->smoother, "Forward filter only");
   cmd->add_flag("!--no-zupt-updates", mo->zupt_updates, "The ZUPT detector only segments steps (no ZUPT updates)");
   cmd->add_flag("--multipath-states", mo->multipath_states,
-                "Filter code-multipath Gauss-Markov states with the scenario's multipath sigma/tau/C/N0 reference");
+                "Filter code-multipath Gauss-Markov states with the scenario's multipath sigma/tau/C/N0 reference (none if "
+                "its sigma is under 1 mm, the run configuration's minimum)");
   cmd->add_flag("--white-code", mo->white_code,
                 "No multipath states (white code errors; `multipath: {states: false}` of pednav run)")
       ->excludes("--multipath-states");

@@ -223,6 +223,9 @@ void read_imu_spec_entry(YamlMap& m, const std::string& key, ins::ImuSpec& spec,
 /// The inverse of read_imu_spec_entry: the preset's name when `spec` is exactly the preset, else the map
 /// {preset: NAME, <every read_imu_spec key>} (config.resolved.yaml reads back to the same spec).
 void emit_imu_spec(YAML::Emitter& e, const ins::ImuSpec& spec, const std::string& preset);
+/// `{preset: NAME, <only the keys whose value differs from the preset's>}` (a flow map for hand-written configs; reads
+/// back to the same spec up to the unit conversion's rounding).
+std::string imu_spec_flow_yaml(const ins::ImuSpec& spec, const std::string& preset);
 /// A built-in IMU format preset (datasets/imu_formats/<name>.yaml), parsed.
 Expected<ImuFormat> imu_format_preset(const std::string& name);
 

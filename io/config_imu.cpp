@@ -1,5 +1,6 @@
 // YAML section reader: `imu:` (log file, format = preset name or inline column map, spec = preset name or
 // inline unit-suffixed values). Keys are documented in README ("IMU log format", "IMU spec").
+#include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -208,6 +209,17 @@ void read_imu_spec_entry(YamlMap& m, const std::string& key, ins::ImuSpec& spec,
     m.text(key, preset);
     start_from_preset(m, key);
   }
+}
+
+std::string imu_spec_flow_yaml(const ins::ImuSpec& spec, const std::string& preset) {
+  const auto p = preset.empty() ? Expected<ins::ImuSpec>(make_error("no preset")) : ins::imu_spec_preset(preset);
+  std::string y = p ? "preset: " + preset : std::string();
+  for (const SpecKey& k : spec_keys()) {
+    const double v = spec.*k.field;
+    if (p && (*p).*k.field == v) continue;
+    y += fmt::format("{}{}: {}", y.empty() ? "" : ", ", k.key, v / k.factor);  // shortest decimal that reads back
+  }
+  return "{" + y + "}";
 }
 
 void emit_imu_spec(YAML::Emitter& e, const ins::ImuSpec& spec, const std::string& preset) {

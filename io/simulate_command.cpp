@@ -10,6 +10,7 @@
 #include "core/rotation.hpp"
 #include "io/atomic_file.hpp"
 #include "io/rinex_writer.hpp"
+#include "sim/gnss_sim.hpp"
 
 namespace pednav::io {
 namespace {
@@ -66,11 +67,45 @@ std::string format_imu_csv(const sim::Simulation& s) {
   return out;
 }
 
-std::string format_run_config(const sim::Simulation& s, const ScenarioFile& f) {
+void apply_data_sheet(const sim::Scenario& sc, const DataSheetParts& parts, RunConfig& c) {
+  if (parts.receiver_weights) {  // docs/consistency.md §3.8
+    const gnss::WeightModel w = sim::receiver_weight_model(sc.gnss);
+    c.gnss.cn0_ref_dbhz = w.cn0_ref_dbhz;
+    c.gnss.code_sigma_zenith_m = w.code_sigma_zenith_m;
+    c.gnss.doppler_sigma_zenith_mps = w.doppler_sigma_zenith_mps;
+    c.gnss.elevation_weight = w.elevation_weight;
+    c.gnss.code_squaring_loss = w.code_squaring_loss;
+  }
+  if (parts.lever_arm) {  // docs/fusion.md §14: antenna height over the foot IMU, the IMU foot beside the walking line
+    c.antenna.lever_arm_ned_m = Eigen::Vector3d(0.0, 0.0, -(sc.gnss.antenna_height_m - sc.gait.imu_height_m));
+    c.antenna.lever_arm_heading_m = Eigen::Vector3d(0.0, -sc.gait.foot_offset_m, 0.0);
+  }
+  if (parts.g_sensitivity) c.imu.spec.gyro_g_sensitivity = sc.imu.gyro_g_sensitivity_sigma;  // docs/error_state.md §5
+  if (parts.multipath) {  // docs/consistency.md §3
+    constexpr double kMinSigma_m = 1e-3;  // the run configuration's lower limit of multipath.sigma_m
+    c.multipath.states = sc.gnss.multipath_sigma_m >= kMinSigma_m;
+    if (c.multipath.states) c.multipath.sigma_m = sc.gnss.multipath_sigma_m;
+    c.multipath.tau_s = sc.gnss.multipath_tau_s;
+    c.multipath.cn0_ref_dbhz = sc.gnss.multipath_cn0_ref_dbhz;
+  }
+}
+
+namespace {
+
+// config.yaml (data_sheet == nullptr) or config_datasheet.yaml text.
+std::string format_config(const sim::Simulation& s, const ScenarioFile& f, const DataSheetParts* data_sheet) {
   const sim::Scenario& sc = s.scenario;
+  const bool any_gnss = s.has_gnss || f.real_gnss.has_value();
   std::string y = fmt::format("# Written by pednav simulate from {} (seed {}). Paths are relative to this file.\n",
                               f.source_file, sc.seed);
-  if (s.has_gnss || f.real_gnss) {
+  RunConfig ds;  // the data-sheet values (only the parts named are read below)
+  if (data_sheet) {
+    apply_data_sheet(sc, *data_sheet, ds);
+    y += "# The data-sheet configuration: the filter gets the simulated sensors' own models instead of pednav run's\n"
+         "# generic defaults (pednav montecarlo --receiver-weights --scenario-lever-arm --g-sensitivity-states\n"
+         "# --multipath-states, where they apply to this scenario; docs/sim.md §7, docs/consistency.md §3.8-3.11).\n";
+    y += any_gnss ? "mode: tc\n" : "mode: ins\n";
+  } else if (any_gnss) {
     y += "# mode gnss: `pednav run` solves the GNSS epochs by least squares; `pednav run --mode tc` (or mode: tc) runs\n"
          "# the tightly coupled filter.\nmode: gnss\n";
   } else {
@@ -93,20 +128,45 @@ std::string format_run_config(const sim::Simulation& s, const ScenarioFile& f) {
     y += "rover_obs: rover.obs\nbase_obs: base.obs\nnav: [nav.rnx]\n";
     y += fmt::format("base_position_ecef_m: [{:.4f}, {:.4f}, {:.4f}]\n", b.x(), b.y(), b.z());
     y += fmt::format("gnss:\n  elevation_mask_deg: {:g}\n", std::max(10.0, sc.gnss.elevation_mask_rad * kRadToDeg));
+    if (data_sheet && data_sheet->receiver_weights) {
+      // Shortest round-trip decimal ({}): the file loads to exactly the values pednav montecarlo uses.
+      y += fmt::format(
+          "  cn0_ref_dbhz: {}\n  code_sigma_zenith_m: {}\n  doppler_sigma_zenith_mps: {}\n  elevation_weight: {}\n"
+          "  code_squaring_loss: {}\n",
+          ds.gnss.cn0_ref_dbhz, ds.gnss.code_sigma_zenith_m, ds.gnss.doppler_sigma_zenith_mps,
+          ds.gnss.elevation_weight, ds.gnss.code_squaring_loss);
+    }
   }
   y += "imu:\n  file: imu.csv\n";
   y += fmt::format(
       "  format:\n    delimiter: \",\"\n    header_lines: 1\n    time: {{base: gps_sow, column: 1, unit: s, gps_week: {}}}\n"
       "    gyro: {{columns: [2, 3, 4], unit: rad_per_s}}\n    accel: {{columns: [5, 6, 7], unit: mps2}}\n",
       s.imu.front().t.week());
-  y += "  spec: " + f.imu_spec_preset + "\n";
+  if (data_sheet && data_sheet->g_sensitivity) {
+    // The scenario's whole spec (preset + its g-sensitivity σ), inline so that it reads back to the same values.
+    ins::ImuSpec spec = sc.imu.spec;
+    spec.gyro_g_sensitivity = sc.imu.gyro_g_sensitivity_sigma;
+    y += "  spec: " + imu_spec_flow_yaml(spec, f.imu_spec_preset) + "\n";
+  } else {
+    y += "  spec: " + f.imu_spec_preset + "\n";
+  }
   y += fmt::format("mechanization_rate_hz: {:g}\n", 20.0);
-  if (!s.has_gnss && !f.real_gnss) {  // mode ins needs the initial position and heading: the truth's
+  if (!any_gnss) {  // mode ins needs the initial position and heading: the truth's
     const ins::NavState& x0 = s.truth.nav.front();
     const Geodetic llh = geodetic_from_ecef(x0.p_eb_e);
     const Eigen::Vector3d rpy = euler_from_R_n_b(R_e_n(llh.lat, llh.lon).transpose() * x0.R_e_b());
     y += fmt::format("initial:\n  lat_deg: {:.10f}\n  lon_deg: {:.10f}\n  h_m: {:.4f}\n  yaw_deg: {:.6f}\n",
                      llh.lat * kRadToDeg, llh.lon * kRadToDeg, llh.h_m, rpy.z() * kRadToDeg);
+  }
+  if (data_sheet && data_sheet->lever_arm && any_gnss) {
+    const Eigen::Vector3d &a = ds.antenna.lever_arm_ned_m, &h = ds.antenna.lever_arm_heading_m;
+    y += fmt::format("antenna:\n  lever_arm_ned_m: [{}, {}, {}]\n  lever_arm_heading_m: [{}, {}, {}]\n", a.x(), a.y(),
+                     a.z(), h.x(), h.y(), h.z());
+  }
+  if (data_sheet && data_sheet->multipath && s.has_gnss) {
+    y += ds.multipath.states ? fmt::format("multipath:\n  states: true\n  sigma_m: {}\n  tau_s: {}\n  cn0_ref_dbhz: {}\n",
+                                           ds.multipath.sigma_m, ds.multipath.tau_s, ds.multipath.cn0_ref_dbhz)
+                             : std::string("multipath:\n  states: false\n");
   }
   if (f.real_gnss) {
     y += "reference:\n  file: " + yaml_path(std::filesystem::absolute(f.real_gnss->reference_file).lexically_normal().string()) +
@@ -116,6 +176,18 @@ std::string format_run_config(const sim::Simulation& s, const ScenarioFile& f) {
     y += "reference:\n  file: truth.csv\n  format: csv\n";
   }
   return y;
+}
+
+}  // namespace
+
+std::string format_run_config(const sim::Simulation& s, const ScenarioFile& f) { return format_config(s, f, nullptr); }
+
+std::string format_data_sheet_config(const sim::Simulation& s, const ScenarioFile& f) {
+  DataSheetParts parts;
+  parts.g_sensitivity = true;
+  parts.lever_arm = s.has_gnss || f.real_gnss.has_value();
+  parts.receiver_weights = parts.multipath = s.has_gnss && !f.real_gnss;
+  return format_config(s, f, &parts);
 }
 
 Expected<SimulateSummary> run_simulate_command(const ScenarioFile& file, const std::string& out_dir) {
@@ -146,6 +218,7 @@ Expected<SimulateSummary> run_simulate_command(const ScenarioFile& file, const s
     sum.blunder_events = sim->gnss.blunder_events;
   }
   if (auto r = put("config.yaml", format_run_config(*sim, file)); !r) return r.error();
+  if (auto r = put("config_datasheet.yaml", format_data_sheet_config(*sim, file)); !r) return r.error();
   sum.duration_s = sim->plan.duration_s;
   sum.distance_m = sim->plan.distance_m;
   sum.strides = static_cast<int>(sim->plan.strides.size());

@@ -1,17 +1,21 @@
 // `pednav simulate` outputs (io/simulate_command.*): same seed -> byte-identical files; a different seed
-// changes them; config.yaml loads as a run configuration pointing at the written files.
+// changes them; config.yaml loads as a run configuration pointing at the written files; config_datasheet.yaml
+// loads to the scenario's own sensor models.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 
 #include "io/config.hpp"
+#include "io/run_command.hpp"
 #include "io/simulate_command.hpp"
+#include "sim/gnss_sim.hpp"
 #include "tests/sim/fixtures.hpp"
 
 namespace pednav {
 namespace {
 
-const char* kFiles[] = {"truth.csv", "imu.csv", "rover.obs", "base.obs", "nav.rnx", "blunders.csv", "config.yaml"};
+const char* kFiles[] = {"truth.csv", "imu.csv", "rover.obs", "base.obs", "nav.rnx", "blunders.csv", "config.yaml",
+                        "config_datasheet.yaml"};
 
 io::ScenarioFile short_walk(uint64_t seed) {
   auto f = test::scenario_from_text(test::kOpenSkyGnssYaml);
@@ -52,6 +56,66 @@ TEST(SimulateCommand, ConfigYamlIsARunConfigurationOnTheWrittenFiles) {
   EXPECT_EQ(cfg->imu.spec_preset, "crista");
   EXPECT_TRUE(std::filesystem::exists(cfg->reference.file));
   EXPECT_EQ(cfg->reference.format, "csv");
+}
+
+TEST(SimulateCommand, DataSheetConfigLoadsToTheScenarioSensorModels) {
+  // Values unlike pednav run's defaults, so that a part the writer leaves out fails the test.
+  io::ScenarioFile f = short_walk(3);
+  f.scenario.imu.gyro_g_sensitivity_sigma = 0.13 * kDegToRad / 9.80665;  // 0.13 °/s/g
+  f.scenario.gnss.multipath_sigma_m = 0.37;
+  f.scenario.gnss.multipath_tau_s = 12.5;
+  f.scenario.gnss.multipath_cn0_ref_dbhz = 43.0;
+  f.scenario.gait.foot_offset_m = 0.12;
+  const sim::Scenario& sc = f.scenario;
+  const std::string d = test::temp_dir("sim_ds");
+  ASSERT_TRUE(io::run_simulate_command(f, d).has_value());
+  auto plain = io::load_run_config(d + "/config.yaml");
+  auto ds = io::load_run_config(d + "/config_datasheet.yaml");
+  ASSERT_TRUE(plain.has_value()) << plain.error().message;
+  ASSERT_TRUE(ds.has_value()) << ds.error().message;
+  EXPECT_EQ(ds->mode, "tc");
+  EXPECT_EQ(ds->gnss.rover_obs, plain->gnss.rover_obs);
+  EXPECT_EQ(ds->imu.file, plain->imu.file);
+
+  // The scenario's models themselves.
+  EXPECT_DOUBLE_EQ(ds->gnss.code_sigma_zenith_m, sim::thermal_code_sigma_m(sc.gnss, sc.gnss.cn0_zenith_dbhz));
+  EXPECT_DOUBLE_EQ(ds->gnss.cn0_ref_dbhz, sc.gnss.cn0_zenith_dbhz);
+  EXPECT_DOUBLE_EQ(ds->gnss.elevation_weight, 0.0);
+  EXPECT_DOUBLE_EQ(ds->antenna.lever_arm_ned_m.z(), -(sc.gnss.antenna_height_m - sc.gait.imu_height_m));
+  EXPECT_DOUBLE_EQ(ds->antenna.lever_arm_heading_m.y(), -0.12);
+  EXPECT_NEAR(ds->imu.spec.gyro_g_sensitivity, sc.imu.gyro_g_sensitivity_sigma, 1e-15);
+  EXPECT_TRUE(ds->multipath.states);
+  EXPECT_DOUBLE_EQ(ds->multipath.sigma_m, 0.37);
+  EXPECT_DOUBLE_EQ(ds->multipath.tau_s, 12.5);
+  EXPECT_DOUBLE_EQ(ds->multipath.cn0_ref_dbhz, 43.0);
+
+  // The same filter as pednav montecarlo's flags (apply_data_sheet on config.yaml) — every other key as config.yaml.
+  io::RunConfig want = *plain;
+  want.mode = "tc";
+  io::apply_data_sheet(sc, io::DataSheetParts::all(), want);
+  const fusion::EngineOptions a = io::engine_options(*ds), b = io::engine_options(want);
+  EXPECT_DOUBLE_EQ(a.weights.code_sigma_zenith_m, b.weights.code_sigma_zenith_m);
+  EXPECT_DOUBLE_EQ(a.weights.doppler_sigma_zenith_mps, b.weights.doppler_sigma_zenith_mps);
+  EXPECT_DOUBLE_EQ(a.weights.cn0_ref_dbhz, b.weights.cn0_ref_dbhz);
+  EXPECT_DOUBLE_EQ(a.weights.elevation_weight, b.weights.elevation_weight);
+  EXPECT_DOUBLE_EQ(a.weights.code_squaring_loss, b.weights.code_squaring_loss);
+  EXPECT_EQ(a.lever_arm_n_m, b.lever_arm_n_m);
+  EXPECT_EQ(a.lever_arm_heading_m, b.lever_arm_heading_m);
+  EXPECT_DOUBLE_EQ(a.multipath_sigma_m, b.multipath_sigma_m);
+  EXPECT_DOUBLE_EQ(a.multipath_tau_s, b.multipath_tau_s);
+  EXPECT_DOUBLE_EQ(a.multipath_cn0_ref_dbhz, b.multipath_cn0_ref_dbhz);
+  EXPECT_NEAR(ds->imu.spec.gyro_g_sensitivity, want.imu.spec.gyro_g_sensitivity, 1e-15);
+  // The rest of the spec is the scenario's (the inline spec's unit conversion rounds at the last bit).
+  EXPECT_NEAR(ds->imu.spec.gyro_arw, sc.imu.spec.gyro_arw, 1e-12 * sc.imu.spec.gyro_arw);
+  EXPECT_NEAR(ds->imu.spec.accel_bias_initial, sc.imu.spec.accel_bias_initial, 1e-12 * sc.imu.spec.accel_bias_initial);
+
+  // A simulated multipath below the configuration's 1 mm minimum: no multipath states (the file still loads).
+  f.scenario.gnss.multipath_sigma_m = 1e-4;
+  const std::string d2 = test::temp_dir("sim_ds2");
+  ASSERT_TRUE(io::run_simulate_command(f, d2).has_value());
+  auto ds2 = io::load_run_config(d2 + "/config_datasheet.yaml");
+  ASSERT_TRUE(ds2.has_value()) << ds2.error().message;
+  EXPECT_FALSE(ds2->multipath.states);
 }
 
 TEST(SimulateCommand, BadScenarioNamesTheKey) {
