@@ -27,6 +27,8 @@
 #include "io/atomic_file.hpp"
 #include "io/config.hpp"
 #include "io/log.hpp"
+#include "io/plot.hpp"
+#include "io/plot_figures.hpp"
 #include "io/run_command.hpp"
 #include "io/scenario_config.hpp"
 #include "io/simulate_command.hpp"
@@ -63,6 +65,7 @@ struct McOptions {
   double elevation_weight = std::numeric_limits<double>::quiet_NaN();  ///< gnss.elevation_weight (NaN: the default)
   bool scenario_lever_arm = false;  ///< antenna lever arm from the scenario's walker geometry (docs/fusion.md §14)
   bool g_sensitivity_states = false;  ///< filter g-sensitivity states with the scenario's σ (docs/error_state.md §5)
+  bool plots = true;               ///< nees.svg, sigma.svg, sigma_yaw.svg, error_vs_distance.svg
   bool receiver_weights = false;   ///< code/Doppler weights from the scenario's receiver model (docs/consistency.md §3.8)
 };
 
@@ -411,6 +414,27 @@ int run_montecarlo(const McOptions& mo) {
       return 1;
     }
   }
+  if (mo.plots) {  // seed 000 Figs. 4-6 (gnuplot; a missing gnuplot costs the figures, not the run)
+    const std::string what = fmt::format("{}, {} runs", file->scenario.name, n_ok);
+    const std::vector<eval::McEpochStats> none;
+    const auto& smo_or_none = have_smoothed ? smo : none;
+    for (const auto& [name, spec] : std::vector<std::pair<std::string, io::PlotSpec>>{
+             {"nees.svg",
+              io::montecarlo_nees_plot(fmt::format("{}: average horizontal NEES (in band: forward {:.1f} %{})", what,
+                                                   100.0 * sf.nees_in_band_fraction,
+                                                   have_smoothed ? fmt::format(", smoothed {:.1f} %",
+                                                                               100.0 * ss.nees_in_band_fraction)
+                                                                 : std::string()),
+                                       fwd, smo_or_none)},
+             {"sigma.svg", io::montecarlo_sigma_plot(what + ": forward position sigma, sample vs filter", fwd, false)},
+             {"sigma_yaw.svg", io::montecarlo_sigma_plot(what + ": forward yaw sigma, sample vs filter", fwd, true)},
+             {"error_vs_distance.svg",
+              io::montecarlo_distance_plot(what + ": RMS horizontal error vs distance", fwd, smo_or_none)}}) {
+      if (auto w = io::write_plot_svg((std::filesystem::path(mo.out_dir) / name).string(), spec); !w) {
+        spdlog::warn("montecarlo: {} not written: {}", name, w.error().message);
+      }
+    }
+  }
   const std::string smoothed_text =
       have_smoothed ? fmt::format("NEES in band {:.1f} %, sigma ratio horizontal {:.3f} yaw {:.3f}, RMS {:.2f} m",
                                   100.0 * ss.nees_in_band_fraction, ss.sigma_ratio_horizontal, ss.sigma_ratio_yaw,
@@ -429,7 +453,7 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
   auto* cmd = app.add_subcommand("montecarlo", "N seeded simulate + run pairs in parallel: NEES, sample vs filter sigma");
   auto mo = std::make_shared<McOptions>();
   cmd->add_option("SCENARIO", mo->scenario_path, "Scenario file (YAML, as for pednav simulate)")->required();
-  cmd->add_option("-o,--output", mo->out_dir, "Output folder (runs/, runs.csv, nees.csv, summary.json)")->required();
+  cmd->add_option("-o,--output", mo->out_dir, "Output folder (runs/, runs.csv, nees.csv, summary.json, *.svg)")->required();
   cmd->add_option("--runs", mo->runs, "Number of runs (seeds scenario.seed + i)")->check(CLI::Range(2, 100000));
   cmd->add_option("--jobs", mo->jobs, "Parallel runs (default: all hardware threads)")->check(CLI::Range(0, 256));
   cmd->add_option("--mode", mo->mode, "tc | ins (default: tc if the scenario simulates GNSS, else ins)")
@@ -438,6 +462,8 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
   cmd->add_option("--seed-offset", mo->seed_offset, "Run i uses seed scenario.seed + offset + i");
   cmd->add_option("--summary-from-s", mo->summary_from_s, "Summarize epochs from this time since the scenario start [s]");
   cmd->add_flag("!--no-smoother", mo->smoother, "Forward filter only");
+  cmd->add_flag("!--no-plots", mo->plots,
+                "No SVG figures (nees.svg, sigma.svg, sigma_yaw.svg, error_vs_distance.svg: seed 000 Figs. 4-6)");
   cmd->add_flag("!--no-zupt-updates", mo->zupt_updates, "The ZUPT detector only segments steps (no ZUPT updates)");
   cmd->add_flag("--multipath-states", mo->multipath_states,
                 "Filter code-multipath Gauss-Markov states with the scenario's multipath sigma/tau/C/N0 reference (none if "

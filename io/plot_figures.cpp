@@ -148,4 +148,97 @@ PlotSpec outage_rms_plot(const std::string& title, const std::vector<double>& t_
   return p;
 }
 
+PlotSpec montecarlo_nees_plot(const std::string& title, const std::vector<eval::McEpochStats>& forward,
+                              const std::vector<eval::McEpochStats>& smoothed) {
+  PlotSpec p;
+  p.title = title;
+  p.x_label = "time since the scenario start [s]";
+  p.y_label = "average horizontal NEES (2 dof)";
+  p.y_from_zero = true;
+  PlotSeries band{"95 % band of the average", PlotStyle::kBand, {}, {}, {}, {}, "#dddddd", 1.0};
+  PlotSeries f{"forward", PlotStyle::kLines, {}, {}, {}, {}, "#1f77b4", 1.5};
+  for (const auto& e : forward) {
+    band.x.push_back(e.t_s);
+    band.y_low.push_back(e.nees_lo_2dof);
+    band.y_high.push_back(e.nees_hi_2dof);
+    f.x.push_back(e.t_s);
+    f.y.push_back(e.nees_horizontal);
+  }
+  p.series.push_back(std::move(band));
+  p.series.push_back(std::move(f));
+  if (!smoothed.empty()) {
+    PlotSeries s{"smoothed", PlotStyle::kLines, {}, {}, {}, {}, "#d62728", 1.5};
+    for (const auto& e : smoothed) {
+      s.x.push_back(e.t_s);
+      s.y.push_back(e.nees_horizontal);
+    }
+    p.series.push_back(std::move(s));
+  }
+  return p;
+}
+
+PlotSpec montecarlo_sigma_plot(const std::string& title, const std::vector<eval::McEpochStats>& epochs, bool yaw) {
+  PlotSpec p;
+  p.title = title;
+  p.x_label = "time since the scenario start [s]";
+  p.y_label = yaw ? "yaw error sigma [deg]" : "position error sigma [m]";
+  p.y_from_zero = true;
+  struct Axis {
+    const char* name;
+    const char *sample_color, *filter_color;
+    double (*sample)(const eval::McEpochStats&);
+    double (*filter)(const eval::McEpochStats&);
+  };
+  const std::vector<Axis> axes =
+      yaw ? std::vector<Axis>{{"yaw", "#2ca02c", "#98df8a",
+                               [](const eval::McEpochStats& e) { return e.sample_sd_yaw_rad * kRadToDeg; },
+                               [](const eval::McEpochStats& e) { return e.filter_sd_yaw_rad * kRadToDeg; }}}
+          : std::vector<Axis>{{"north", "#1f77b4", "#9ecae1",
+                               [](const eval::McEpochStats& e) { return e.sample_sd_ned_m.x(); },
+                               [](const eval::McEpochStats& e) { return e.filter_sd_ned_m.x(); }},
+                              {"east", "#d62728", "#fc9272",
+                               [](const eval::McEpochStats& e) { return e.sample_sd_ned_m.y(); },
+                               [](const eval::McEpochStats& e) { return e.filter_sd_ned_m.y(); }}};
+  for (const Axis& a : axes) {
+    PlotSeries s{std::string(a.name) + ": sample sigma of the error", PlotStyle::kLines, {}, {}, {}, {},
+                 a.sample_color, 1.5};
+    PlotSeries f{std::string(a.name) + ": filter sigma", PlotStyle::kLines, {}, {}, {}, {}, a.filter_color, 2.5};
+    for (const auto& e : epochs) {
+      s.x.push_back(e.t_s);
+      s.y.push_back(a.sample(e));
+      f.x.push_back(e.t_s);
+      f.y.push_back(a.filter(e));
+    }
+    p.series.push_back(std::move(f));
+    p.series.push_back(std::move(s));
+  }
+  return p;
+}
+
+PlotSpec montecarlo_distance_plot(const std::string& title, const std::vector<eval::McEpochStats>& forward,
+                                  const std::vector<eval::McEpochStats>& smoothed) {
+  PlotSpec p;
+  p.title = title;
+  p.x_label = "distance walked [m]";
+  p.y_label = "RMS horizontal error across the runs [m]";
+  p.y_from_zero = true;
+  PlotSeries line{"3 % of the distance", PlotStyle::kLines, {}, {}, {}, {}, "#7f7f7f", 1.0};
+  auto add = [&](const char* name, const std::vector<eval::McEpochStats>& ep, const char* color) {
+    PlotSeries s{name, PlotStyle::kLines, {}, {}, {}, {}, color, 1.5};
+    for (const auto& e : ep) {
+      s.x.push_back(e.distance_m);
+      s.y.push_back(e.rms_horizontal_m);
+    }
+    p.series.push_back(std::move(s));
+  };
+  double d_max = 0.0;
+  for (const auto& e : forward) d_max = std::max(d_max, e.distance_m);
+  line.x = {0.0, d_max};
+  line.y = {0.0, 0.03 * d_max};
+  p.series.push_back(std::move(line));
+  add("forward", forward, "#1f77b4");
+  if (!smoothed.empty()) add("smoothed", smoothed, "#d62728");
+  return p;
+}
+
 }  // namespace pednav::io

@@ -1,12 +1,13 @@
 // The standard figures of pednav (compare, report, outage) as PlotSpecs for io/plot.hpp: trajectory against the
 // reference in local East/North, error vs time with the +-3 sigma envelope, error CDF, satellites used/rejected,
-// ZUPT timeline, outage RMS vs time since the outage started.
+// ZUPT timeline, outage RMS vs time since the outage started, Monte Carlo consistency (seed 000 Figs. 4-6).
 #pragma once
 
 #include <Eigen/Core>
 #include <string>
 #include <vector>
 
+#include "eval/montecarlo.hpp"
 #include "eval/trajectory.hpp"
 #include "io/plot.hpp"
 
@@ -53,5 +54,19 @@ PlotSpec zupt_plot(const std::vector<double>& t_s, const std::vector<double>& zu
 /// Outage study: RMS across windows vs time since the outage started (forward, and smoothed if given).
 PlotSpec outage_rms_plot(const std::string& title, const std::vector<double>& t_since_s,
                          const std::vector<double>& rms_forward_m, const std::vector<double>& rms_smoothed_m);
+
+/// Monte Carlo: the average horizontal NEES over the runs against time, forward and (if given) smoothed, with the
+/// two-sided 95 % band of the average (χ²(2M)/M; docs/consistency.md §1).
+PlotSpec montecarlo_nees_plot(const std::string& title, const std::vector<eval::McEpochStats>& forward,
+                              const std::vector<eval::McEpochStats>& smoothed);
+
+/// Monte Carlo (seed 000 Figs. 4-5): the sample σ of the error across the runs against the filter's σ (√ of the mean
+/// P) for north and east, or for yaw [deg] with `yaw`.
+PlotSpec montecarlo_sigma_plot(const std::string& title, const std::vector<eval::McEpochStats>& epochs, bool yaw);
+
+/// Monte Carlo (seed 000 Fig. 6): RMS horizontal error across the runs against the distance walked, with the line
+/// of 3 % of the distance.
+PlotSpec montecarlo_distance_plot(const std::string& title, const std::vector<eval::McEpochStats>& forward,
+                                  const std::vector<eval::McEpochStats>& smoothed);
 
 }  // namespace pednav::io

@@ -1,9 +1,11 @@
 // `pednav montecarlo` flags that change the filter reach it (docs/consistency.md §1, §3.12): the same seeds with
-// and without `--no-doppler` give different per-run errors, and the same flags twice give identical ones.
+// and without `--no-doppler` give different per-run errors, and the same flags twice give identical ones; the
+// figures are written unless `--no-plots`.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -45,6 +47,12 @@ TEST(MontecarloFlags, NoDopplerChangesTheFilterAndRunsAreReproducible) {
   ASSERT_EQ(std::count(with_doppler.begin(), with_doppler.end(), '\n'), 2) << with_doppler;
   EXPECT_EQ(with_doppler, again) << "same seeds and flags: identical runs";
   EXPECT_NE(with_doppler, code_only) << "--no-doppler must reach the filter";
+  for (const char* f : {"nees.svg", "sigma.svg", "sigma_yaw.svg", "error_vs_distance.svg"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir + "/a/" + f)) << f;
+    EXPECT_NE(test::read_text(dir + "/a/" + f).find("<svg"), std::string::npos) << f;
+  }
+  run_montecarlo(scenario, dir + "/d", "--no-plots");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/d/nees.svg")) << "--no-plots";
 }
 
 }  // namespace

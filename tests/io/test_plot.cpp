@@ -73,5 +73,49 @@ TEST(PlotFigures, ZuptFractionAndEnvelope) {
   EXPECT_TRUE(std::isnan(e.series[0].y_high[1]));
 }
 
+TEST(PlotFigures, MontecarloNeesSigmaAndDistance) {
+  std::vector<eval::McEpochStats> fwd(3), smo(3);
+  for (int i = 0; i < 3; ++i) {
+    eval::McEpochStats& e = fwd[static_cast<size_t>(i)];
+    e.t_s = 10.0 * i;
+    e.distance_m = 100.0 * i;
+    e.nees_horizontal = 2.0 + 0.1 * i;
+    e.nees_lo_2dof = 1.6;
+    e.nees_hi_2dof = 2.4 + 0.01 * i;
+    e.sample_sd_ned_m = Eigen::Vector3d(0.5 + i, 0.4, 0.0);
+    e.filter_sd_ned_m = Eigen::Vector3d(0.6, 0.3 + i, 0.0);
+    e.sample_sd_yaw_rad = 0.01;
+    e.filter_sd_yaw_rad = 0.02;
+    e.rms_horizontal_m = 1.0 + i;
+    smo[static_cast<size_t>(i)] = e;
+    smo[static_cast<size_t>(i)].nees_horizontal = 3.0;
+  }
+  const PlotSpec n = montecarlo_nees_plot("t", fwd, smo);
+  ASSERT_EQ(n.series.size(), 3u);  // band, forward, smoothed
+  EXPECT_EQ(n.series[0].style, PlotStyle::kBand);
+  EXPECT_DOUBLE_EQ(n.series[0].y_low[2], 1.6);
+  EXPECT_DOUBLE_EQ(n.series[0].y_high[2], 2.42);
+  EXPECT_DOUBLE_EQ(n.series[1].y[1], 2.1);
+  EXPECT_DOUBLE_EQ(n.series[2].y[0], 3.0);
+  EXPECT_EQ(montecarlo_nees_plot("t", fwd, {}).series.size(), 2u);  // no smoothed solution: no smoothed line
+
+  const PlotSpec s = montecarlo_sigma_plot("t", fwd, false);
+  ASSERT_EQ(s.series.size(), 4u);  // north filter, north sample, east filter, east sample
+  EXPECT_DOUBLE_EQ(s.series[0].y[2], 0.6);
+  EXPECT_DOUBLE_EQ(s.series[1].y[2], 2.5);
+  EXPECT_DOUBLE_EQ(s.series[2].y[2], 2.3);
+  EXPECT_DOUBLE_EQ(s.series[3].y[2], 0.4);
+  const PlotSpec y = montecarlo_sigma_plot("t", fwd, true);
+  ASSERT_EQ(y.series.size(), 2u);
+  EXPECT_NEAR(y.series[0].y[0], 0.02 * 180.0 / M_PI, 1e-12);  // degrees
+
+  const PlotSpec d = montecarlo_distance_plot("t", fwd, smo);
+  ASSERT_EQ(d.series.size(), 3u);  // the 3 % line, forward, smoothed
+  EXPECT_DOUBLE_EQ(d.series[0].x.back(), 200.0);
+  EXPECT_DOUBLE_EQ(d.series[0].y.back(), 6.0);
+  EXPECT_DOUBLE_EQ(d.series[1].x[1], 100.0);
+  EXPECT_DOUBLE_EQ(d.series[1].y[1], 2.0);
+}
+
 }  // namespace
 }  // namespace pednav::io
