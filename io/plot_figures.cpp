@@ -148,46 +148,56 @@ PlotSpec outage_rms_plot(const std::string& title, const std::vector<double>& t_
   return p;
 }
 
-PlotSpec montecarlo_nees_plot(const std::string& title, const std::vector<eval::McEpochStats>& forward,
-                              const std::vector<eval::McEpochStats>& smoothed) {
+namespace {
+
+// An empty plot with its y axis from zero.
+PlotSpec zero_based_plot(const std::string& title, const char* x_label, const char* y_label) {
   PlotSpec p;
   p.title = title;
-  p.x_label = "time since the scenario start [s]";
-  p.y_label = "average horizontal NEES (2 dof)";
+  p.x_label = x_label;
+  p.y_label = y_label;
   p.y_from_zero = true;
+  return p;
+}
+
+// One line of a Monte Carlo figure: x(e), y(e) over the epochs.
+using EpochValue = double (*)(const eval::McEpochStats&);
+PlotSeries epoch_line(const std::string& name, const std::vector<eval::McEpochStats>& epochs, EpochValue x,
+                      EpochValue y, const char* color, double width) {
+  PlotSeries s{name, PlotStyle::kLines, {}, {}, {}, {}, color, width};
+  for (const auto& e : epochs) {
+    s.x.push_back(x(e));
+    s.y.push_back(y(e));
+  }
+  return s;
+}
+double time_s(const eval::McEpochStats& e) { return e.t_s; }
+
+}  // namespace
+
+PlotSpec montecarlo_nees_plot(const std::string& title, const std::vector<eval::McEpochStats>& forward,
+                              const std::vector<eval::McEpochStats>& smoothed) {
+  PlotSpec p = zero_based_plot(title, "time since the scenario start [s]", "average horizontal NEES (2 dof)");
   PlotSeries band{"95 % band of the average", PlotStyle::kBand, {}, {}, {}, {}, "#dddddd", 1.0};
-  PlotSeries f{"forward", PlotStyle::kLines, {}, {}, {}, {}, "#1f77b4", 1.5};
   for (const auto& e : forward) {
     band.x.push_back(e.t_s);
     band.y_low.push_back(e.nees_lo_2dof);
     band.y_high.push_back(e.nees_hi_2dof);
-    f.x.push_back(e.t_s);
-    f.y.push_back(e.nees_horizontal);
   }
+  const EpochValue nees = [](const eval::McEpochStats& e) { return e.nees_horizontal; };
   p.series.push_back(std::move(band));
-  p.series.push_back(std::move(f));
-  if (!smoothed.empty()) {
-    PlotSeries s{"smoothed", PlotStyle::kLines, {}, {}, {}, {}, "#d62728", 1.5};
-    for (const auto& e : smoothed) {
-      s.x.push_back(e.t_s);
-      s.y.push_back(e.nees_horizontal);
-    }
-    p.series.push_back(std::move(s));
-  }
+  p.series.push_back(epoch_line("forward", forward, time_s, nees, "#1f77b4", 1.5));
+  if (!smoothed.empty()) p.series.push_back(epoch_line("smoothed", smoothed, time_s, nees, "#d62728", 1.5));
   return p;
 }
 
 PlotSpec montecarlo_sigma_plot(const std::string& title, const std::vector<eval::McEpochStats>& epochs, bool yaw) {
-  PlotSpec p;
-  p.title = title;
-  p.x_label = "time since the scenario start [s]";
-  p.y_label = yaw ? "yaw error sigma [deg]" : "position error sigma [m]";
-  p.y_from_zero = true;
+  PlotSpec p = zero_based_plot(title, "time since the scenario start [s]",
+                               yaw ? "yaw error sigma [deg]" : "position error sigma [m]");
   struct Axis {
     const char* name;
     const char *sample_color, *filter_color;
-    double (*sample)(const eval::McEpochStats&);
-    double (*filter)(const eval::McEpochStats&);
+    EpochValue sample, filter;
   };
   const std::vector<Axis> axes =
       yaw ? std::vector<Axis>{{"yaw", "#2ca02c", "#98df8a",
@@ -200,44 +210,23 @@ PlotSpec montecarlo_sigma_plot(const std::string& title, const std::vector<eval:
                                [](const eval::McEpochStats& e) { return e.sample_sd_ned_m.y(); },
                                [](const eval::McEpochStats& e) { return e.filter_sd_ned_m.y(); }}};
   for (const Axis& a : axes) {
-    PlotSeries s{std::string(a.name) + ": sample sigma of the error", PlotStyle::kLines, {}, {}, {}, {},
-                 a.sample_color, 1.5};
-    PlotSeries f{std::string(a.name) + ": filter sigma", PlotStyle::kLines, {}, {}, {}, {}, a.filter_color, 2.5};
-    for (const auto& e : epochs) {
-      s.x.push_back(e.t_s);
-      s.y.push_back(a.sample(e));
-      f.x.push_back(e.t_s);
-      f.y.push_back(a.filter(e));
-    }
-    p.series.push_back(std::move(f));
-    p.series.push_back(std::move(s));
+    p.series.push_back(epoch_line(std::string(a.name) + ": filter sigma", epochs, time_s, a.filter, a.filter_color, 2.5));
+    p.series.push_back(
+        epoch_line(std::string(a.name) + ": sample sigma of the error", epochs, time_s, a.sample, a.sample_color, 1.5));
   }
   return p;
 }
 
 PlotSpec montecarlo_distance_plot(const std::string& title, const std::vector<eval::McEpochStats>& forward,
                                   const std::vector<eval::McEpochStats>& smoothed) {
-  PlotSpec p;
-  p.title = title;
-  p.x_label = "distance walked [m]";
-  p.y_label = "RMS horizontal error across the runs [m]";
-  p.y_from_zero = true;
-  PlotSeries line{"3 % of the distance", PlotStyle::kLines, {}, {}, {}, {}, "#7f7f7f", 1.0};
-  auto add = [&](const char* name, const std::vector<eval::McEpochStats>& ep, const char* color) {
-    PlotSeries s{name, PlotStyle::kLines, {}, {}, {}, {}, color, 1.5};
-    for (const auto& e : ep) {
-      s.x.push_back(e.distance_m);
-      s.y.push_back(e.rms_horizontal_m);
-    }
-    p.series.push_back(std::move(s));
-  };
+  PlotSpec p = zero_based_plot(title, "distance walked [m]", "RMS horizontal error across the runs [m]");
   double d_max = 0.0;
   for (const auto& e : forward) d_max = std::max(d_max, e.distance_m);
-  line.x = {0.0, d_max};
-  line.y = {0.0, 0.03 * d_max};
-  p.series.push_back(std::move(line));
-  add("forward", forward, "#1f77b4");
-  if (!smoothed.empty()) add("smoothed", smoothed, "#d62728");
+  p.series.push_back({"3 % of the distance", PlotStyle::kLines, {0.0, d_max}, {0.0, 0.03 * d_max}, {}, {}, "#7f7f7f", 1.0});
+  const EpochValue d = [](const eval::McEpochStats& e) { return e.distance_m; };
+  const EpochValue rms = [](const eval::McEpochStats& e) { return e.rms_horizontal_m; };
+  p.series.push_back(epoch_line("forward", forward, d, rms, "#1f77b4", 1.5));
+  if (!smoothed.empty()) p.series.push_back(epoch_line("smoothed", smoothed, d, rms, "#d62728", 1.5));
   return p;
 }
 
