@@ -65,6 +65,7 @@ struct McOptions {
   double elevation_weight = std::numeric_limits<double>::quiet_NaN();  ///< gnss.elevation_weight (NaN: the default)
   bool scenario_lever_arm = false;  ///< antenna lever arm from the scenario's walker geometry (docs/fusion.md §14)
   bool g_sensitivity_states = false;  ///< filter g-sensitivity states with the scenario's σ (docs/error_state.md §5)
+  double window_s = 150.0;         ///< summary.json windows_*: the band test per window of this length [s]
   bool plots = true;               ///< nees.svg, sigma.svg, sigma_yaw.svg, error_vs_distance.svg
   bool receiver_weights = false;   ///< code/Doppler weights from the scenario's receiver model (docs/consistency.md §3.8)
 };
@@ -406,6 +407,19 @@ int run_montecarlo(const McOptions& mo) {
   j["min_runs_per_epoch"] = min_runs;
   j["forward"] = summary_json(sf);
   j["smoothed"] = have_smoothed ? summary_json(ss) : nlohmann::json(nullptr);
+  // The band test by time window (docs/consistency.md §1, §3.13): where the in-band share is lost.
+  auto windows_json = [&](const std::vector<eval::McEpochStats>& ep) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const eval::McWindowBand& w : eval::window_bands(ep, mo.window_s)) {
+      a.push_back({{"from_s", w.from_s}, {"to_s", w.to_s}, {"epochs", w.epochs},
+                   {"nees_in_band_fraction", w.nees_in_band_fraction},
+                   {"mean_nees_horizontal", w.mean_nees_horizontal}});
+    }
+    return a;
+  };
+  j["window_s"] = mo.window_s;
+  j["windows_forward"] = windows_json(fwd);
+  j["windows_smoothed"] = have_smoothed ? windows_json(smo) : nlohmann::json(nullptr);
   for (const auto& [name, text] : {std::pair<std::string, std::string>{"runs.csv", rc.str()},
                                    {"nees.csv", nc.str()},
                                    {"summary.json", j.dump(2) + "\n"}}) {
@@ -462,6 +476,9 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
   cmd->add_option("--seed-offset", mo->seed_offset, "Run i uses seed scenario.seed + offset + i");
   cmd->add_option("--summary-from-s", mo->summary_from_s, "Summarize epochs from this time since the scenario start [s]");
   cmd->add_flag("!--no-smoother", mo->smoother, "Forward filter only");
+  cmd->add_option("--window-s", mo->window_s,
+                  "Window length of summary.json's windows_forward/windows_smoothed (NEES in band per window) [s]")
+      ->check(CLI::Range(1.0, 1e6));
   cmd->add_flag("!--no-plots", mo->plots,
                 "No SVG figures (nees.svg, sigma.svg, sigma_yaw.svg, error_vs_distance.svg: seed 000 Figs. 4-6)");
   cmd->add_flag("!--no-zupt-updates", mo->zupt_updates, "The ZUPT detector only segments steps (no ZUPT updates)");

@@ -148,4 +148,22 @@ McSummary summarize(const std::vector<McEpochStats>& epochs, int runs, double t_
   return m;
 }
 
+std::vector<McWindowBand> window_bands(const std::vector<McEpochStats>& epochs, double window_s) {
+  std::vector<McWindowBand> out;
+  if (!(window_s > 0.0)) return out;
+  for (const McEpochStats& e : epochs) {
+    const double from = std::floor(std::max(0.0, e.t_s) / window_s) * window_s;
+    if (out.empty() || out.back().from_s != from) out.push_back({from, from + window_s, 0, 0.0, 0.0});
+    McWindowBand& w = out.back();
+    ++w.epochs;
+    w.nees_in_band_fraction += e.nees_horizontal >= e.nees_lo_2dof && e.nees_horizontal <= e.nees_hi_2dof;
+    w.mean_nees_horizontal += e.nees_horizontal;
+  }
+  for (McWindowBand& w : out) {
+    w.nees_in_band_fraction /= w.epochs;
+    w.mean_nees_horizontal /= w.epochs;
+  }
+  return out;
+}
+
 }  // namespace pednav::eval

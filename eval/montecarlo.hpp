@@ -60,6 +60,19 @@ struct McSummary {
   double rms_horizontal_m = 0.0;               ///< RMS horizontal error over all runs and epochs [m]
 };
 
+/// The NEES band test per time window. The epochs of a window are not independent tests (the errors of a filter,
+/// and more so of a smoother, are correlated over many epochs; a stand is one draw: docs/consistency.md §3.13), so
+/// the windows show where the in-band share is lost, and how few independent tests it rests on.
+struct McWindowBand {
+  double from_s = 0.0, to_s = 0.0;     ///< [from, to) since the scenario start [s]
+  int epochs = 0;                      ///< epochs of the summary inside the window
+  double nees_in_band_fraction = 0.0;  ///< share of those epochs with the horizontal NEES inside its 95 % band
+  double mean_nees_horizontal = 0.0;   ///< mean of the average NEES over those epochs (2 when consistent)
+};
+
+/// Consecutive windows of `window_s` from t = 0 to the last epoch (windows without epochs are left out).
+std::vector<McWindowBand> window_bands(const std::vector<McEpochStats>& epochs, double window_s);
+
 /// Per-epoch statistics of forward or smoothed errors (`smoothed` selects McRun::smoothed). Epochs are keyed by
 /// t_s rounded to `key_resolution_s`; epochs present in fewer than `min_runs` runs are left out (min_runs >= 2).
 std::vector<McEpochStats> aggregate_epochs(const std::vector<McRun>& runs, bool smoothed, int min_runs,

@@ -51,8 +51,20 @@ TEST(MontecarloFlags, NoDopplerChangesTheFilterAndRunsAreReproducible) {
     EXPECT_TRUE(std::filesystem::exists(dir + "/a/" + f)) << f;
     EXPECT_NE(test::read_text(dir + "/a/" + f).find("<svg"), std::string::npos) << f;
   }
-  run_montecarlo(scenario, dir + "/d", "--no-plots");
+  run_montecarlo(scenario, dir + "/d", "--no-plots --window-s 10");
   EXPECT_FALSE(std::filesystem::exists(dir + "/d/nees.svg")) << "--no-plots";
+  // summary.json's band test per window: one entry per --window-s of the walk.
+  auto windows = [](const std::string& summary) {
+    const std::string j = test::read_text(summary);
+    const size_t a = j.find("\"windows_forward\""), b = j.find("\"windows_smoothed\"");
+    if (a == std::string::npos || b == std::string::npos) return -1;
+    int n = 0;
+    for (size_t p = j.find("\"from_s\"", a); p != std::string::npos && p < b; p = j.find("\"from_s\"", p + 1)) ++n;
+    return n;
+  };
+  const int n150 = windows(dir + "/a/summary.json"), n10 = windows(dir + "/d/summary.json");
+  EXPECT_GE(n150, 1);
+  EXPECT_GT(n10, n150) << "--window-s must reach summary.json";
 }
 
 }  // namespace

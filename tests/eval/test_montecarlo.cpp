@@ -96,6 +96,28 @@ TEST(MonteCarloStats, OptimisticFilterIsAboveTheBand) {
   EXPECT_NEAR(s.sigma_ratio_horizontal_pooled, 1.5, 1.5 * kRatioTol);
 }
 
+TEST(MonteCarloStats, WindowBandsCountTheEpochsOfEachWindow) {
+  std::vector<McEpochStats> ep(400);
+  for (int i = 0; i < 400; ++i) {
+    McEpochStats& e = ep[static_cast<size_t>(i)];
+    e.t_s = i;
+    e.nees_lo_2dof = 1.6;
+    e.nees_hi_2dof = 2.4;
+    e.nees_horizontal = i >= 150 && i < 225 ? 3.0 : 2.0;  // half of the second window above the band
+  }
+  const auto w = window_bands(ep, 150.0);
+  ASSERT_EQ(w.size(), 3u);
+  EXPECT_DOUBLE_EQ(w[0].from_s, 0.0);
+  EXPECT_DOUBLE_EQ(w[1].to_s, 300.0);
+  EXPECT_EQ(w[0].epochs, 150);
+  EXPECT_EQ(w[2].epochs, 100);  // the last window is partial
+  EXPECT_DOUBLE_EQ(w[0].nees_in_band_fraction, 1.0);
+  EXPECT_DOUBLE_EQ(w[1].nees_in_band_fraction, 0.5);
+  EXPECT_DOUBLE_EQ(w[1].mean_nees_horizontal, 2.5);
+  EXPECT_DOUBLE_EQ(w[2].nees_in_band_fraction, 1.0);
+  EXPECT_TRUE(window_bands(ep, 0.0).empty());
+}
+
 TEST(MonteCarloStats, EpochsMissingInManyRunsAreLeftOut) {
   auto runs = synthetic_runs(10, 5, 1.0, 9);
   runs[0].forward.pop_back();  // the last epoch is in 9 runs only
