@@ -18,6 +18,9 @@ struct Acc {
   int inside3 = 0;
 };
 
+// The epoch's average horizontal NEES is inside its two-sided 95 % band.
+bool nees_in_band(const McEpochStats& e) { return e.nees_horizontal >= e.nees_lo_2dof && e.nees_horizontal <= e.nees_hi_2dof; }
+
 }  // namespace
 
 double normal_quantile(double p) {
@@ -114,7 +117,7 @@ McSummary summarize(const std::vector<McEpochStats>& epochs, int runs, double t_
     const double fh = e.filter_sd_ned_m.head<2>().norm();
     if (fh > 0) ratio_h.push_back(e.sample_sd_ned_m.head<2>().norm() / fh);
     if (e.filter_sd_yaw_rad > 0) ratio_y.push_back(e.sample_sd_yaw_rad / e.filter_sd_yaw_rad);
-    in_h += e.nees_horizontal >= e.nees_lo_2dof && e.nees_horizontal <= e.nees_hi_2dof;
+    in_h += nees_in_band(e);
     above += e.nees_horizontal > e.nees_hi_2dof;
     below += e.nees_horizontal < e.nees_lo_2dof;
     in_y += e.nees_yaw >= e.nees_lo_1dof && e.nees_yaw <= e.nees_hi_1dof;
@@ -156,7 +159,7 @@ std::vector<McWindowBand> window_bands(const std::vector<McEpochStats>& epochs, 
     if (out.empty() || out.back().from_s != from) out.push_back({from, from + window_s, 0, 0.0, 0.0});
     McWindowBand& w = out.back();
     ++w.epochs;
-    w.nees_in_band_fraction += e.nees_horizontal >= e.nees_lo_2dof && e.nees_horizontal <= e.nees_hi_2dof;
+    w.nees_in_band_fraction += nees_in_band(e);
     w.mean_nees_horizontal += e.nees_horizontal;
   }
   for (McWindowBand& w : out) {

@@ -212,7 +212,7 @@ void read_imu_spec_entry(YamlMap& m, const std::string& key, ins::ImuSpec& spec,
 }
 
 std::string imu_spec_flow_yaml(const ins::ImuSpec& spec, const std::string& preset) {
-  const auto p = preset.empty() ? Expected<ins::ImuSpec>(make_error("no preset")) : ins::imu_spec_preset(preset);
+  const auto p = ins::imu_spec_preset(preset);  // an error for "" and unknown names: every key is written
   std::string y = p ? "preset: " + preset : std::string();
   for (const SpecKey& k : spec_keys()) {
     const double v = spec.*k.field;

@@ -158,12 +158,12 @@ std::string format_config(const sim::Simulation& s, const ScenarioFile& f, const
     y += fmt::format("initial:\n  lat_deg: {:.10f}\n  lon_deg: {:.10f}\n  h_m: {:.4f}\n  yaw_deg: {:.6f}\n",
                      llh.lat * kRadToDeg, llh.lon * kRadToDeg, llh.h_m, rpy.z() * kRadToDeg);
   }
-  if (data_sheet && data_sheet->lever_arm && any_gnss) {
+  if (data_sheet && data_sheet->lever_arm) {
     const Eigen::Vector3d &a = ds.antenna.lever_arm_ned_m, &h = ds.antenna.lever_arm_heading_m;
     y += fmt::format("antenna:\n  lever_arm_ned_m: [{}, {}, {}]\n  lever_arm_heading_m: [{}, {}, {}]\n", a.x(), a.y(),
                      a.z(), h.x(), h.y(), h.z());
   }
-  if (data_sheet && data_sheet->multipath && s.has_gnss) {
+  if (data_sheet && data_sheet->multipath) {
     y += ds.multipath.states ? fmt::format("multipath:\n  states: true\n  sigma_m: {}\n  tau_s: {}\n  cn0_ref_dbhz: {}\n",
                                            ds.multipath.sigma_m, ds.multipath.tau_s, ds.multipath.cn0_ref_dbhz)
                              : std::string("multipath:\n  states: false\n");
