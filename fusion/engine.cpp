@@ -679,6 +679,11 @@ class Runner {
     if (in.rover) {
       for (const auto& e : *in.rover) max_sats = std::max(max_sats, e.sats.size());
     }
+    if (in.imu) {
+      // The stance samples a ZUPT may use; the core of a short stance spans one mechanization interval, so that
+      // every detected stance keeps at least one update.
+      zupt_ok_ = ins::zupt_update_samples(decisions, *in.imu, o.zupt_edge_s, 1.0 / o.mechanization_rate_hz);
+    }
     if (o.repair_saturation && in.imu) {
       ins::SaturationOptions so;
       so.gyro_range_radps = o.spec.gyro_range;
@@ -788,7 +793,7 @@ class Runner {
     int last_used = 0, last_rejected = 0;
     bool failed = false;
     int64_t last_covariance_check_ns = std::numeric_limits<int64_t>::min() / 2;
-    bool prev_stance = false;  // stance at the previous mechanization epoch (= this interval's start)
+    bool prev_zupt = false;  // a ZUPT at the previous mechanization epoch (ZARU: the whole interval is stance)
     std::optional<StepTracker> steps;  // seed 000 step-velocity aiding (fusion/step_velocity.hpp)
     if (o_.step_velocity.enabled) steps.emplace(o_.step_velocity);
     std::string fail_message;
@@ -809,8 +814,9 @@ class Runner {
       // ZUPT (+ ZARU) when the detector flags the sample at the interval end as stance.
       const bool stance = decisions_[std::min(sample_index, decisions_.size() - 1)].stance;
       stride_.push(inc.t1.ns(), f.x().nav.p_eb_e - p_before, stance);  // mechanized displacement only (eq. 13.1)
-      if (stance && o_.zupt_updates) {
-        zupt_update(f, inc, prev_stance);
+      const bool zupt_now = stance && zupt_ok_[std::min(sample_index, zupt_ok_.size() - 1)];
+      if (zupt_now && o_.zupt_updates) {
+        zupt_update(f, inc, prev_zupt);
         ++sum.zupt_updates;
       }
       if (steps) {
@@ -822,7 +828,7 @@ class Runner {
                     o_.record_gnss_rows ? &result.gnss_rows : nullptr);
         ++gi;
       }
-      prev_stance = stance;
+      prev_zupt = zupt_now;
       std::string why;
       const bool output_now = inc.t1.ns() >= next_out_ns;
       // The symmetry / PSD test (an LDLT) at output epochs, at most once per second (outputs at the mechanization
@@ -922,7 +928,7 @@ class Runner {
         integrator = ins::IncrementIntegrator(io);  // the increments restart at this sample
         clock_initialized = false;
         implausible_streak_ = 0;
-        prev_stance = false;
+        prev_zupt = false;
         last_used = last_rejected = 0;
         stride_.reset();
         if (steps) steps.emplace(o_.step_velocity);
@@ -1415,6 +1421,7 @@ class Runner {
   const EngineInputs& in_;
   const EngineOptions& o_;
   const std::vector<ins::ZuptDecision>& decisions_;
+  std::vector<bool> zupt_ok_;  // stance samples a ZUPT/ZARU may use (zupt_edge_s trimmed; ins::zupt_update_samples)
   const double w_test_threshold_;  // chi2(1) quantile at o_.fault_probability
   ins::SaturationRepair saturation_;  // clipped samples repaired once per run (docs/ins.md §9)
   StrideVelocity stride_;             // stride-average foot velocity: the antenna velocity (docs/fusion.md §13)

@@ -37,6 +37,7 @@ struct EngineOptions {
   ins::ZuptDetectorOptions zupt;
   ZuptForm zupt_form = ZuptForm::kDynamic;
   double zupt_sigma_mps = 0.02;         ///< ZUPT measurement noise per axis [m/s]
+  double zupt_edge_s = 0.02;            ///< ZUPT/ZARU skip the first and last zupt_edge_s of each stance (docs/zupt.md §5)
   bool zaru = true;                     ///< zero angular-rate update during stance (mean rate of an all-stance interval)
   double zaru_sigma_radps = 0.01;       ///< [rad/s]
   bool zupt_updates = true;             ///< false: the detector only segments steps (step-velocity-only aiding)

@@ -240,6 +240,37 @@ std::vector<double> shoe_statistic(const std::vector<ImuSample>& s, const ZuptDe
   return out;
 }
 
+std::vector<bool> zupt_update_samples(const std::vector<ZuptDecision>& d, const std::vector<ImuSample>& s,
+                                      double edge_s, double min_core_s) {
+  const std::size_t n = std::min(d.size(), s.size());
+  std::vector<bool> ok(d.size(), false);
+  for (std::size_t i = 0; i < n;) {
+    if (!d[i].stance) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j + 1 < n && d[j + 1].stance) ++j;
+    const double t0 = 0.0, t1 = s[j].t - s[i].t;
+    // The run without its edges, or else its central min_core_s.
+    double lo = t0 + edge_s, hi = t1 - edge_s;
+    if (hi - lo < min_core_s) {
+      const double mid = 0.5 * (t0 + t1), half = 0.5 * std::min(min_core_s, t1 - t0);
+      lo = mid - half;
+      hi = mid + half;
+    }
+    bool any = false;
+    for (std::size_t k = i; k <= j; ++k) {
+      const double tk = s[k].t - s[i].t;
+      ok[k] = tk >= lo - 1e-9 && tk <= hi + 1e-9;
+      any = any || ok[k];
+    }
+    if (!any) ok[i + (j - i) / 2] = true;
+    i = j + 1;
+  }
+  return ok;
+}
+
 std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& s, const ZuptDetectorOptions& o) {
   const int n = static_cast<int>(s.size());
   std::vector<ZuptDecision> d(n);

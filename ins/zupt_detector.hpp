@@ -105,4 +105,11 @@ std::vector<double> shoe_statistic(const std::vector<ImuSample>& samples, const 
 /// Run the configured detector over time-ordered samples (GPST). Returns one decision per sample.
 std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& samples, const ZuptDetectorOptions& options);
 
+/// Samples whose stance may be used by a ZUPT/ZARU update (docs/zupt.md §5): each stance run of `d` without its
+/// first and last edge_s (at the onset and the end of a stance a detector's window still flags the foot's last
+/// millimetres per second of motion). A run too short for that keeps its central min_core_s (at least one sample),
+/// so that no detected stance loses every update. edge_s = 0: the stance flags themselves.
+std::vector<bool> zupt_update_samples(const std::vector<ZuptDecision>& d, const std::vector<ImuSample>& s,
+                                      double edge_s, double min_core_s);
+
 }  // namespace pednav::ins

@@ -140,7 +140,8 @@ std::string to_yaml(const RunConfig& c) {
     << c.antenna.stride_velocity_sigma_vertical_mps << YAML::EndMap;
   e << YAML::Key << "mechanization_rate_hz" << YAML::Value << c.mechanization_rate_hz;
   e << YAML::Key << "zupt" << YAML::Value << YAML::BeginMap << YAML::Key << "detector" << YAML::Value
-    << c.zupt.detector << YAML::Key << "form" << YAML::Value << c.zupt.form << YAML::EndMap;
+    << c.zupt.detector << YAML::Key << "form" << YAML::Value << c.zupt.form << YAML::Key << "edge_s" << YAML::Value
+    << c.zupt.edge_s << YAML::EndMap;
   e << YAML::Key << "fault_rejection" << YAML::Value << YAML::BeginMap << YAML::Key << "probability"
     << YAML::Value << c.fault_rejection_probability << YAML::EndMap;
   e << YAML::Key << "smoother" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled" << YAML::Value

@@ -94,6 +94,7 @@ struct ZuptConfig {
   double shoe_adaptive_factor = 0.0;      ///< gait-adaptive SHOE threshold factor (0: off; ins::ZuptDetectorOptions)
   double shoe_adaptive_window_s = 0.6;
   double sigma_mps = 0.02;                ///< ZUPT measurement noise per axis
+  double edge_s = 0.02;                   ///< ZUPT/ZARU skip the first and last edge_s of each stance (docs/zupt.md §5)
   bool zaru = true;
   double zaru_sigma_radps = 0.01;         ///< key zaru_sigma_deg_per_s
 };

@@ -27,6 +27,7 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
     z.number("min_stance_s", c.min_stance_s, false, 0.0, 5.0);
     read_zupt_hmm_keys(z, c);
     z.number("sigma_mps", c.sigma_mps, false, 1e-6, 10.0);
+    z.number("edge_s", c.edge_s, false, 0.0, 1.0);
     z.boolean("zaru", c.zaru);
     double zs = c.zaru_sigma_radps * kRadToDeg;
     z.number("zaru_sigma_deg_per_s", zs, false, 1e-9, 100.0);

@@ -100,6 +100,7 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.zupt = zupt_detector_options(c.zupt);  // all detector keys incl. ARE/MAG/HMM (io/hmm_model_io.cpp)
   o.zupt_form = c.zupt.form == "F" ? fusion::ZuptForm::kFull : fusion::ZuptForm::kDynamic;
   o.zupt_sigma_mps = c.zupt.sigma_mps;
+  o.zupt_edge_s = c.zupt.edge_s;
   o.zaru = c.zupt.zaru;
   o.zaru_sigma_radps = c.zupt.zaru_sigma_radps;
   o.initial_position_e = c.initial.position_e;

@@ -314,3 +314,29 @@ TEST(ZuptDetector, ShortWholeStepIsWidenedOthersAreNot) {
 
 }  // namespace
 }  // namespace pednav::ins
+
+namespace pednav::ins {
+namespace {
+
+// zupt_update_samples (docs/zupt.md §5) at 100 Hz: a 0.30-s stance loses 20 ms at each end; a 50-ms stance is
+// shorter than its edges and keeps its central min_core_s (30 ms here); a single-sample stance keeps that sample;
+// edge 0 returns the stance flags themselves.
+TEST(ZuptDetector, UpdateSamplesSkipTheStanceEdges) {
+  std::vector<ImuSample> s(100);
+  std::vector<ZuptDecision> d(100);
+  for (int k = 0; k < 100; ++k) s[k].t = GpsTime::from_week_tow(0, k / 100.0);
+  for (int k = 10; k <= 39; ++k) d[k].stance = true;  // 0.29 s from first to last sample
+  for (int k = 50; k <= 55; ++k) d[k].stance = true;  // 0.05 s
+  d[70].stance = true;
+  const std::vector<bool> ok = zupt_update_samples(d, s, 0.02, 0.03);
+  for (int k = 0; k < 100; ++k) {
+    bool expected = (k >= 12 && k <= 37) || (k >= 51 && k <= 54) || k == 70;
+    if (k >= 51 && k <= 54) expected = std::abs(k / 100.0 - 0.525) <= 0.015 + 1e-9;  // centre 0.525 s ± 15 ms
+    EXPECT_EQ(ok[k], expected) << "sample " << k;
+  }
+  const std::vector<bool> flags = zupt_update_samples(d, s, 0.0, 0.03);
+  for (int k = 0; k < 100; ++k) EXPECT_EQ(flags[k], d[k].stance) << "sample " << k;
+}
+
+}  // namespace
+}  // namespace pednav::ins
