@@ -811,7 +811,8 @@ class Runner {
       const Vector3d p_before = f.x().nav.p_eb_e;
       f.predict(inc);
       ++sum.mechanization_steps;
-      // ZUPT (+ ZARU) when the detector flags the sample at the interval end as stance.
+      // ZUPT (+ ZARU) when the detector flags the sample at the interval end as stance, away from the stance's
+      // edges (zupt_edge_s, docs/zupt.md §5).
       const bool stance = decisions_[std::min(sample_index, decisions_.size() - 1)].stance;
       stride_.push(inc.t1.ns(), f.x().nav.p_eb_e - p_before, stance);  // mechanized displacement only (eq. 13.1)
       const bool zupt_now = stance && zupt_ok_[std::min(sample_index, zupt_ok_.size() - 1)];
@@ -1068,7 +1069,8 @@ class Runner {
   }
 
   // ZUPT: z = 0 - v_est; form D adds the attitude coupling [v×] (seed 001 eq. 8); ZARU: omega - b_g - omega_ie.
-  // ZARU uses the mean (bias-corrected) rate over the interval, only when the whole interval is stance.
+  // ZARU uses the mean (bias-corrected) rate over the interval, only when the whole interval is stance (its start
+  // had a ZUPT too, so neither end is at a stance edge).
   void zupt_update(Filter& f, const ins::ImuIncrement& inc, bool interval_start_stance) {
     const int n = f.layout().dim();
     const Vector3d v = f.x().nav.v_eb_e;

@@ -251,13 +251,13 @@ std::vector<bool> zupt_update_samples(const std::vector<ZuptDecision>& d, const 
     }
     std::size_t j = i;
     while (j + 1 < n && d[j + 1].stance) ++j;
-    const double t0 = 0.0, t1 = s[j].t - s[i].t;
-    // The run without its edges, or else its central min_core_s.
-    double lo = t0 + edge_s, hi = t1 - edge_s;
+    // Times from the run's first sample: the run without its edges, or else its central min_core_s.
+    const double len = s[j].t - s[i].t;
+    double lo = edge_s, hi = len - edge_s;
     if (hi - lo < min_core_s) {
-      const double mid = 0.5 * (t0 + t1), half = 0.5 * std::min(min_core_s, t1 - t0);
-      lo = mid - half;
-      hi = mid + half;
+      const double half = 0.5 * std::min(min_core_s, len);
+      lo = 0.5 * len - half;
+      hi = 0.5 * len + half;
     }
     bool any = false;
     for (std::size_t k = i; k <= j; ++k) {
