@@ -236,6 +236,23 @@ TEST(Config, ScaleBiasCompensationKeyReachesTheEngineOptionsAndRoundTrips) {
   EXPECT_THAT(bad.error().message, HasSubstr("scale_factors.bias_compensation"));
 }
 
+// zupt.edge_s (docs/zupt.md §5): default 0.02 s, reaches the engine, survives the resolved YAML, range-checked.
+TEST(Config, ZuptEdgeKeyReachesTheEngineAndRoundTrips) {
+  const std::string files = "mode: tc\nrover_obs: r.obs\nnav: n.nav\nimu: {file: i.csv, spec: crista}\n";
+  auto def = parse(files);
+  ASSERT_TRUE(def) << def.error().message;
+  EXPECT_DOUBLE_EQ(engine_options(*def).zupt_edge_s, 0.02);
+  auto cfg = parse(files + "zupt: {edge_s: 0.035}\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_DOUBLE_EQ(engine_options(*cfg).zupt_edge_s, 0.035);
+  auto again = parse(to_yaml(*cfg));
+  ASSERT_TRUE(again) << again.error().message << "\n" << to_yaml(*cfg);
+  EXPECT_DOUBLE_EQ(again->zupt.edge_s, 0.035);
+  auto bad = parse(files + "zupt: {edge_s: -0.01}\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("zupt.edge_s: value -0.01 is out of range"));
+}
+
 TEST(Config, AntennaVelocityModelKeysAndResolvedRoundTrip) {
   const std::string files = "mode: gnss\nrover_obs: r.obs\nnav: n.nav\n";
   auto def = parse(files);
