@@ -46,8 +46,8 @@ void add_zupt_command(CLI::App& app, Action& action) {
         spdlog::error("{}", sum.error().message);
         return 1;
       }
-      spdlog::info("zupt ({}): {} of {} samples stance in {} intervals, {:.2f} s -> {}", sum->detector,
-                   sum->stance_samples, sum->samples, sum->stance_intervals, sum->wall_s, *out);
+      spdlog::info("zupt ({}): {} of {} samples stance in {} intervals, {} steps, {:.2f} s -> {}", sum->detector,
+                   sum->stance_samples, sum->samples, sum->stance_intervals, sum->steps, sum->wall_s, *out);
       if (sum->detector == "hmm") {
         spdlog::info("hmm: {} observations, {} Baum-Welch iterations on the log; transition matrix A (rows "
                      "from, columns to A B C D):\n{}",

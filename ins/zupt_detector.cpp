@@ -88,7 +88,7 @@ std::vector<std::string> ZuptDetectorOptions::problems() const {
 }
 
 // docs/zupt.md §3: keep the contiguous core of each stance run where the SHOE statistic is below
-// max(γ, factor · its minimum in the run), widened to min_stance_s.
+// max(γ, factor · its minimum in the run), widened to min_stance_s, and the run's other samples with T < γ.
 void refine_hmm_stances(std::vector<ZuptDecision>& d, const std::vector<ImuSample>& s, const std::vector<double>& t,
                         const ZuptDetectorOptions& o) {
   auto next_stance_start = [&](std::size_t j) {  // first stance sample after the run ending at j (or the end)
@@ -128,7 +128,11 @@ void refine_hmm_stances(std::vector<ZuptDecision>& d, const std::vector<ImuSampl
         ++b;
       }
     }
-    for (std::size_t k = std::min(a, i); k <= std::max(b, j); ++k) d[k].stance = k >= a && k <= b;
+    // Outside the core, the decoded stance keeps the samples that pass SHOE's own test (T < γ): the HMM says which
+    // phase the foot is in, SHOE which of its samples are still. A foot that rocks on its heel and toe has two quiet
+    // parts in one stance; the core keeps one of them.
+    for (std::size_t k = std::min(a, i); k <= std::max(b, j); ++k)
+      d[k].stance = (k >= a && k <= b) || (k >= i && k <= j && t[k] < o.shoe_threshold);
     prev_end = b + 1;
     i = std::max(b, j) + 1;
   }
@@ -236,6 +240,28 @@ std::vector<double> shoe_statistic(const std::vector<ImuSample>& s, const ZuptDe
     double t = 0.0;
     for (int j = a; j <= b; ++j) t += ia * (s[j].f_ib_b - g_dir).squaredNorm() + ig * s[j].omega_ib_b.squaredNorm();
     out[k] = t / static_cast<double>(b - a + 1);
+  }
+  return out;
+}
+
+std::vector<std::pair<std::size_t, std::size_t>> stance_phases(const std::vector<ZuptDecision>& d) {
+  std::vector<std::pair<std::size_t, std::size_t>> out;
+  for (std::size_t i = 0; i < d.size();) {
+    if (!d[i].stance) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    for (;;) {
+      while (j + 1 < d.size() && d[j + 1].stance) ++j;
+      // Merge the next run when every sample in between was decoded stance (HMM): the same footfall.
+      std::size_t k = j + 1;
+      while (k < d.size() && !d[k].stance && d[k].gait_state == kStance) ++k;
+      if (k == j + 1 || k >= d.size() || !d[k].stance) break;
+      j = k;
+    }
+    out.emplace_back(i, j);
+    i = j + 1;
   }
   return out;
 }

@@ -4,6 +4,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/expected.hpp"
@@ -76,11 +77,12 @@ struct ZuptDecision {
 /// stance interrupted by a flicker) are left alone.
 void drop_stances_right_after_push_off(std::vector<ZuptDecision>& d, const std::vector<ImuSample>& s, double min_s);
 
-/// HMM post-processing (docs/zupt.md §3): each stance run of `d` keeps only its contiguous core where the SHOE
+/// HMM post-processing (docs/zupt.md §3): each stance run of `d` keeps its contiguous core where the SHOE
 /// statistic `t` (one per sample) is below max(γ, hmm_refine_factor · its minimum in the run); a core shorter than
 /// min_stance_s is widened towards the smaller T — beyond the run only when the run is a whole step of its own
 /// (gait_state heel strike before it, push-off after it, a swing since the previous stance), and never into the
-/// neighbouring stance runs.
+/// neighbouring stance runs. Outside the core the run keeps the samples with T < γ (SHOE's own test), so one
+/// footfall may become several stance runs; stance_phases() counts it once.
 void refine_hmm_stances(std::vector<ZuptDecision>& d, const std::vector<ImuSample>& s, const std::vector<double>& t,
                         const ZuptDetectorOptions& o);
 
@@ -104,6 +106,11 @@ std::vector<double> shoe_statistic(const std::vector<ImuSample>& samples, const 
 
 /// Run the configured detector over time-ordered samples (GPST). Returns one decision per sample.
 std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& samples, const ZuptDetectorOptions& options);
+
+/// Footfalls of a detection, as [first, last] sample indices: the stance runs of `d`, where runs separated only by
+/// samples the HMM decoded as stance (gait_state kStance) are one footfall (refine_hmm_stances may split a decoded
+/// stance into its still parts). Without HMM states (other detectors) these are the stance runs themselves.
+std::vector<std::pair<std::size_t, std::size_t>> stance_phases(const std::vector<ZuptDecision>& d);
 
 /// Samples whose stance may be used by a ZUPT/ZARU update (docs/zupt.md §5): each stance run of `d` without its
 /// first and last edge_s (at the onset and the end of a stance a detector's window still flags the foot's last

@@ -90,18 +90,21 @@ Expected<ZuptCommandSummary> run_zupt_command(const RunConfig& c, const std::str
     sum.stance_samples += d[k].stance;
     sum.stance_intervals += d[k].stance && (k == 0 || !d[k - 1].stance);
   }
+  sum.steps = static_cast<long>(ins::stance_phases(d).size());
   sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   j["detector"] = sum.detector;
   j["imu_file"] = c.imu.file;
   j["samples"] = sum.samples;
   j["stance_samples"] = sum.stance_samples;
   j["stance_intervals"] = sum.stance_intervals;
+  j["steps"] = sum.steps;
   j["wall_s"] = sum.wall_s;
   // Detections plot (io/plot, gnuplot): stance flag and the statistic scaled to its largest magnitude (HMM: the
   // smoothed signed axis rate; also the decoded state / 3), at most ~20000 points. A missing gnuplot is a warning.
   {
     PlotSpec ps;
-    ps.title = "zero-velocity detector " + sum.detector + ": " + std::to_string(sum.stance_intervals) + " stance intervals";
+    ps.title = "zero-velocity detector " + sum.detector + ": " + std::to_string(sum.steps) + " steps, " +
+               std::to_string(sum.stance_intervals) + " stance intervals";
     ps.x_label = "GPS time of week [s]";
     ps.y_label = "stance (0/1), statistic / max|statistic|";
     double smax = 0.0;

@@ -16,7 +16,9 @@ struct ZuptCommandSummary {
   std::string detector;
   long samples = 0;
   long stance_samples = 0;
-  long stance_intervals = 0;        ///< runs of stance samples ("steps" incl. the initial and final rest)
+  long stance_intervals = 0;        ///< runs of stance samples
+  long steps = 0;                   ///< footfalls incl. the initial and final rest (ins::stance_phases; = the
+                                    ///< stance runs except where the HMM splits one decoded stance into its still parts)
   long hmm_observations = 0;        ///< hmm only: length of the observation sequence
   int hmm_iterations = 0;           ///< hmm only: Baum-Welch iterations on the log
   ins::HmmModel hmm_model;          ///< hmm only: the model used for decoding

@@ -58,20 +58,11 @@ TEST(DataZuptHmm, XioLongRestIsStanceAndStanceIsNearZeroRate) {
   EXPECT_EQ(stance_off_zero, 0);
 }
 
-// Stance intervals of a detection: [first, last] sample times since the log start [s].
+// Footfalls of a detection (ins::stance_phases): [first, last] sample times since the log start [s].
 std::vector<std::pair<double, double>> stance_intervals(const std::vector<ZuptDecision>& d,
                                                         const std::vector<ImuSample>& s) {
   std::vector<std::pair<double, double>> out;
-  for (std::size_t i = 0; i < d.size();) {
-    if (!d[i].stance) {
-      ++i;
-      continue;
-    }
-    std::size_t j = i;
-    while (j + 1 < d.size() && d[j + 1].stance) ++j;
-    out.emplace_back(s[i].t - s.front().t, s[j].t - s.front().t);
-    i = j + 1;
-  }
+  for (const auto& [i, j] : stance_phases(d)) out.emplace_back(s[i].t - s.front().t, s[j].t - s.front().t);
   return out;
 }
 

@@ -312,6 +312,39 @@ TEST(ZuptDetector, ShortWholeStepIsWidenedOthersAreNot) {
   EXPECT_EQ(stance(60, 66), "0001100");    // a second D of the same stance (no swing since 54-59): not widened
 }
 
+// refine_hmm_stances outside the core: a foot that rocks on heel and toe has two still parts in one decoded stance.
+// The core is the part around the smallest T; the other part's samples with T < γ are stance too (a ZUPT may use
+// them), the samples between them are not, and stance_phases() still counts one footfall. A gap that is not decoded
+// stance (a push-off) separates footfalls.
+TEST(ZuptDetector, HmmRefineKeepsEveryStillPartOfTheDecodedStance) {
+  //                  0         1         2         3
+  //                  0123456789012345678901234567890123456789
+  const char* gait = "AABBBBBCCDDDDDDDDDDDDDDDDDDDDAAAABBBCCDDDDD";
+  // A, B, C; D 9-28 (one decoded stance); A 29-32, B, C; D 38-42.
+  std::vector<ImuSample> s;
+  std::vector<ZuptDecision> d;
+  gait_from_string(gait, s, d);
+  std::vector<double> T(s.size(), 60.0);
+  for (int k = 9; k <= 28; ++k) T[static_cast<std::size_t>(k)] = 25.0;          // rolling
+  for (int k = 10; k <= 14; ++k) T[static_cast<std::size_t>(k)] = 2.0 + 0.1 * k;   // heel flat: the core (T_min 3)
+  for (int k = 19; k <= 25; ++k) T[static_cast<std::size_t>(k)] = 7.0;             // toe flat: T < γ = 10
+  for (int k = 38; k <= 42; ++k) T[static_cast<std::size_t>(k)] = 4.0;
+  ZuptDetectorOptions o;
+  o.hmm_refine_factor = 2.0;
+  o.min_stance_s = 0.04;
+  refine_hmm_stances(d, s, T, o);
+  std::string r;
+  for (const auto& x : d) r += x.stance ? '1' : '0';
+  EXPECT_EQ(r.substr(9, 20), "01111100001111111000") << r;  // both still parts, not the roll between them
+  const auto phases = stance_phases(d);
+  ASSERT_EQ(phases.size(), 2u) << r;
+  EXPECT_EQ(phases[0], std::make_pair(std::size_t{10}, std::size_t{25}));
+  EXPECT_EQ(phases[1], std::make_pair(std::size_t{38}, std::size_t{42}));
+  // Without HMM states (another detector) every stance run is a footfall.
+  for (auto& x : d) x.gait_state = -1;
+  EXPECT_EQ(stance_phases(d).size(), 3u);
+}
+
 }  // namespace
 }  // namespace pednav::ins
 
