@@ -38,6 +38,10 @@
 namespace pednav::apps {
 namespace {
 
+// Mode ins starts every run from the true position and heading; its P says so (1 cm, 0.1°: small, not zero).
+constexpr double kTrueStartSigmaPosM = 0.01;
+constexpr double kTrueStartSigmaYawRad = 0.1 * 3.14159265358979323846 / 180.0;
+
 struct McOptions {
   std::string scenario_path;
   std::string out_dir;
@@ -173,6 +177,10 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
     const ins::NavState& t0n = s->truth.nav.front();
     o.initial_position_e = t0n.p_eb_e;
     o.initial_yaw_rad = yaw_n(t0n);
+    // ... and say so in P: the configured 5 m / 10° are for a typed-in start, and would make every σ ratio and
+    // NEES of an ins run measure the initial uncertainty instead of the drift (docs/consistency.md §1).
+    o.initial_sigma_pos_m = kTrueStartSigmaPosM;
+    o.initial_sigma_yaw_rad = kTrueStartSigmaYawRad;
   }
   auto res = fusion::run_forward(in, o);
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
