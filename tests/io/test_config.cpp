@@ -130,8 +130,8 @@ TEST(Config, AccelOnlyScaleStatesAndBiasModelKeys) {
   EXPECT_THAT(bad.error().message, HasSubstr("scale_factors.states: expected one of {auto, true, false}, got 'maybe'"));
 }
 
-// The defaults depend on the mode (docs/consistency.md §3.3): tc gets accelerometer scale-factor states and the
-// random-walk bias model, ins neither; explicit keys win; the resolved configuration writes what was used.
+// The defaults depend on the mode (docs/consistency.md §3.3, §3.15): tc gets scale-factor states and the random-walk
+// bias model, ins the scale-factor states only for an uncalibrated (≥ 1 %) gyro; explicit keys win; the resolved configuration writes what was used.
 TEST(Config, ImuErrorModelDefaultsDependOnTheMode) {
   const std::string files = "rover_obs: r.obs\nnav: n.nav\nimu: {file: i.csv, format: pyshoe, spec: crista}\n";
   auto tc = parse("mode: tc\n" + files);
@@ -147,9 +147,15 @@ TEST(Config, ImuErrorModelDefaultsDependOnTheMode) {
   m = imu_error_model_choice(*tc_acc);
   EXPECT_TRUE(m.scale_states);
   EXPECT_FALSE(m.gyro_scale_states);
-  auto ins = parse("mode: ins\n" + files);
+  auto ins = parse("mode: ins\n" + files);  // crista: gyro scale-factor σ 1 %, uncalibrated (§3.15)
   ASSERT_TRUE(ins) << ins.error().message;
   m = imu_error_model_choice(*ins);
+  EXPECT_TRUE(m.scale_states);
+  EXPECT_TRUE(m.gyro_scale_states);
+  EXPECT_FALSE(m.bias_random_walk);
+  auto ins_calibrated = parse("mode: ins\nimu: {file: i.csv, format: pyshoe, spec: ngimu}\n");  // 0.5 %
+  ASSERT_TRUE(ins_calibrated) << ins_calibrated.error().message;
+  m = imu_error_model_choice(*ins_calibrated);
   EXPECT_FALSE(m.scale_states);
   EXPECT_FALSE(m.bias_random_walk);
   auto tc_off = parse("mode: tc\n" + files + "scale_factors: {states: false}\nbias: {model: gauss_markov}\n");
