@@ -66,6 +66,7 @@ struct McOptions {
   bool no_doppler = false;             ///< no Doppler rows (`gnss: {use_doppler: false}`)
   bool foot_antenna_velocity = false;  ///< Doppler rows with the foot's own velocity (`antenna: {velocity_model: foot}`)
   std::optional<bool> scale_bias_compensation;  ///< scale_factors.bias_compensation (unset: the default)
+  std::optional<bool> smoother_eiv_regression;  ///< EngineOptions::smoother_eiv_regression (unset: the default)
   double elevation_weight = std::numeric_limits<double>::quiet_NaN();  ///< gnss.elevation_weight (NaN: the default)
   bool scenario_lever_arm = false;  ///< antenna lever arm from the scenario's walker geometry (docs/fusion.md §14)
   bool g_sensitivity_states = false;  ///< filter g-sensitivity states with the scenario's σ (docs/error_state.md §5)
@@ -150,6 +151,7 @@ RunRecord run_one(const io::ScenarioFile& file, const McOptions& mo, int index) 
   if (!std::isnan(mo.elevation_weight)) c.gnss.elevation_weight = mo.elevation_weight;
   if (mo.scale_bias_compensation) c.scale_factors.bias_compensation = *mo.scale_bias_compensation;
   fusion::EngineOptions o = io::engine_options(c);
+  if (mo.smoother_eiv_regression) o.smoother_eiv_regression = *mo.smoother_eiv_regression;
   if (mo.scale_states || mo.accel_scale_states) o.estimate_scale_factors = true;
   if (mo.scale_states) o.estimate_gyro_scale_factors = true;  // both blocks (the tc default since session 7)
   if (mo.accel_scale_states) o.estimate_gyro_scale_factors = false;
@@ -531,6 +533,10 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
   cmd->add_option("--scale-bias-compensation", mo->scale_bias_compensation,
                   "true/false: subtract the errors-in-variables bias of the scale-factor updates "
                   "(scale_factors.bias_compensation, default true; docs/consistency.md §3.6-3.7)");
+  cmd->add_option("--smoother-eiv-regression", mo->smoother_eiv_regression,
+                  "true/false: remove the errors-in-variables bias from the smoother's mean in every component by "
+                  "regression on the scale states (default true, docs/consistency.md eq. E.7) or in the scale rows "
+                  "only (false, eq. E.6)");
   cmd->add_flag("--step-velocity", mo->step_velocity, "Seed 000 step-averaged velocity aiding");
   cmd->add_option("--leg-length-m", mo->leg_length_m, "Inverted-pendulum length l of the step-length model [m]")
       ->check(CLI::Range(0.05, 3.0));

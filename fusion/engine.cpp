@@ -316,13 +316,13 @@ class Filter {
             if (recording_) interval_.update(H, nu, So_ldlt, Ko);
             eiv_update_all(eivo_, H, So_ldlt, Ko, eivo_bias);
           })) {
-        eiv_subtract(eivo_, eivo_bias, dxo, recording_);
+        eiv_subtract(eivo_, eivo_bias, dxo, recording_, Po_);
         eta_ += dxo;
       }
     }
     // The smoother's interval conditions on the forward filter's residual unless the Kalman-gain filter runs (then η
     // carries the subtraction, eq. 12.23).
-    eiv_subtract(eiv_, eiv_bias, dx, recording_ && !shadow_);
+    eiv_subtract(eiv_, eiv_bias, dx, recording_ && !shadow_, P_);
     apply(dx);
     if (shadow_) eta_ -= dx;  // the nominal moved by dx: the error's conditional mean moves by −dx (eq. 12.23)
     return true;
@@ -600,14 +600,26 @@ class Filter {
     const int n_nz = nonzero_columns(H, nz);
     for (size_t j = 0; j < terms.size(); ++j) bias[j] = eiv_update(terms[j].M, H, nz, n_nz, S_ldlt, K);
   }
-  // Subtract the mean noise parts from the correction dx (docs/consistency.md eq. E.4) and, with shift_interval, move
-  // the smoother interval's mean by the same amount: without that its scale estimate at the interval's start would
-  // take the subtraction back (eq. E.6).
-  void eiv_subtract(std::vector<EivTerm>& terms, const double* bias, ErrorVector& dx, bool shift_interval) {
+  // Subtract the mean noise parts from the correction dx (docs/consistency.md eq. E.4) and, with shift_interval,
+  // remove the same bias from the smoother interval's mean: in every component by regression on the scale states
+  // (eq. E.7; P: the covariance after the update of the filter whose residual the interval conditions on), or in
+  // the scale rows only (eq. E.6) — without either, its scale estimate at the interval's start would take the
+  // subtraction back.
+  void eiv_subtract(std::vector<EivTerm>& terms, const double* bias, ErrorVector& dx, bool shift_interval,
+                    const ErrorMatrix& P) {
+    int states[kMaxEivTerms];
+    double deviation[kMaxEivTerms];
     for (size_t j = 0; j < terms.size(); ++j) {
       dx(terms[j].state) -= bias[j];
       terms[j].total += bias[j];
-      if (shift_interval) interval_.shift_mean(terms[j].state, -bias[j]);
+      states[j] = terms[j].state;
+      deviation[j] = -bias[j];
+    }
+    if (!shift_interval) return;
+    if (o_.smoother_eiv_regression) {
+      interval_.shift_mean_regressed(states, deviation, static_cast<int>(terms.size()), P);
+    } else {
+      for (size_t j = 0; j < terms.size(); ++j) interval_.shift_mean(states[j], deviation[j]);
     }
   }
 

@@ -86,6 +86,10 @@ struct EngineOptions {
   /// With estimate_scale_factors: subtract the errors-in-variables bias of the scale-factor updates (the scale
   /// columns of Φ are built from the measured, noisy rate and specific force; docs/consistency.md §3.6).
   bool scale_bias_compensation = true;
+  /// With scale_bias_compensation and the smoother: remove the same errors-in-variables bias from the smoother
+  /// interval's mean in every component, by regression on the scale states (docs/consistency.md eq. E.7); false:
+  /// in the scale rows only (eq. E.6, the smoother of sessions 11-18).
+  bool smoother_eiv_regression = true;
   /// IMU bias model of the filter. false: one first-order Gauss-Markov state per axis with the spec's instability σ
   /// and τ, started at the turn-on σ — its variance then decays towards the instability σ within ~τ whether or not
   /// anything observes the bias. true: the turn-on bias is a random constant and the instability a random walk of

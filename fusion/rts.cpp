@@ -104,6 +104,26 @@ void RtsInterval::reexpress(const ErrorMatrix& J) {
   Gamma_ = tmp_;
 }
 
+void RtsInterval::shift_mean_regressed(const int* states, const double* delta, int n, const ErrorMatrix& P) {
+  constexpr int kMaxStates = 6;  // gyro + accelerometer scale factors
+  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxStates, kMaxStates>;
+  using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxStates, 1>;
+  if (n <= 0) return;
+  Small P_SS(std::min(n, kMaxStates), std::min(n, kMaxStates));
+  SmallVec d(P_SS.rows());
+  for (int a = 0; a < P_SS.rows(); ++a) {
+    d(a) = delta[a];
+    for (int b = 0; b < P_SS.rows(); ++b) P_SS(a, b) = P(states[a], states[b]);
+  }
+  const Eigen::LLT<Small> llt(P_SS);
+  if (n > kMaxStates || llt.info() != Eigen::Success) {
+    for (int a = 0; a < n; ++a) shift_mean(states[a], delta[a]);
+    return;
+  }
+  const SmallVec y = llt.solve(d);
+  for (int a = 0; a < n; ++a) mu_.noalias() += Gamma_.col(states[a]) * y(a);
+}
+
 // A fresh variable is uncorrelated with δx_a (eq. 12.19).
 void RtsInterval::restart_state(int i) {
   Gamma_.col(i).setZero();

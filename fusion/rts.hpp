@@ -108,6 +108,14 @@ class RtsInterval {
   /// row (δx_a,i = δx_j,i + the corrections fed back since a), so E[δx_a,i | Y] moves by delta too: μ_i += delta
   /// (docs/consistency.md eq. E.6; the regression of δx_a's other components on the deviation is left out).
   void shift_mean(int i, double delta) { mu_(i) += delta; }
+  /// The errors-in-variables bias of the interval's own conditioning (docs/consistency.md eq. E.7): Γ ← Γ Φᵀ with
+  /// the noisy scale columns of Φ gives Γ a noise part Γ_{:,s} wᵀ — the same noise direction w that P's scale row
+  /// carries as P_ss wᵀ (eq. E.2) — so μ += Γ Hᵀ S⁻¹ r picks up Γ_{:,s} / P_ss times the scale update's bias b_s in
+  /// every component, not only in the scale row (eq. E.6). With deviations delta = −b at the scale states
+  /// states[0..n) and P the filter covariance after the update: μ ← μ + Γ_{:,S} P_SS⁻¹ delta. In row s ∈ S (a
+  /// constant: Γ_{s,S} = P_{s,S}) this is shift_mean(s, delta_s). Falls back to shift_mean per state when P_SS is not
+  /// positive definite.
+  void shift_mean_regressed(const int* states, const double* delta, int n, const ErrorMatrix& P);
   /// State i restarted as a fresh variable independent of everything before (clock, drift, multipath slot reset,
   /// docs/fusion.md §7, §12.4): Γ.col(i) ← 0 (eq. 12.19).
   void restart_state(int i);

@@ -550,6 +550,49 @@ TEST(RtsInterval, FeedbackDeviationOnAConstantStateKeepsItsSmoothedValueConstant
   EXPECT_GT(worst_old, 0.5);  // the defect is visible without the shift, else the test proves nothing
 }
 
+// shift_mean_regressed (docs/consistency.md eq. E.7): μ moves by Γ_{:,S} P_SS⁻¹ δ; in the row of a constant state
+// (Γ's row = P's row) that is δ itself, as shift_mean (eq. E.6) does.
+TEST(RtsInterval, RegressedShiftMovesEveryComponentAndTheConstantRowsByDelta) {
+  std::mt19937 rng(4u);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  constexpr int n = 6;
+  const int states[2] = {4, 5};
+  const double delta[2] = {0.3, -0.2};
+  MatrixXd P = random_spd(rng, n, 1.0);
+  fusion::RtsInterval iv(n);
+  iv.restart(P);
+  for (int k = 0; k < 5; ++k) {  // a few steps so that Γ differs from P in the non-constant rows
+    MatrixXd Phi = MatrixXd::Identity(n, n);
+    for (int i = 0; i < n - 2; ++i) {
+      for (int j = 0; j < n; ++j) Phi(i, j) += 0.1 * nd(rng);
+    }
+    MatrixXd Qd = random_spd(rng, n, 0.01);
+    Qd.bottomRows(2).setZero();
+    Qd.rightCols(2).setZero();
+    P = Phi * P * Phi.transpose() + Qd;
+    iv.predict(Phi);
+    MatrixXd H = MatrixXd::Zero(1, n);
+    for (int j = 0; j < n - 2; ++j) H(0, j) = nd(rng);
+    const MatrixXd S = H * P * H.transpose() + MatrixXd::Identity(1, 1) * 0.1;
+    const Eigen::LDLT<MatrixXd> ldlt(S);
+    const MatrixXd K = ldlt.solve(H * P).transpose();
+    iv.update(H, VectorXd::Constant(1, nd(rng)), ldlt, K);
+    P = (MatrixXd::Identity(n, n) - K * H) * P;
+    P = 0.5 * (P + P.transpose()).eval();
+  }
+  const VectorXd mu0 = iv.mean();
+  const MatrixXd Gamma = iv.cross();
+  iv.shift_mean_regressed(states, delta, 2, P);
+  Eigen::Matrix2d P_SS;
+  P_SS << P(4, 4), P(4, 5), P(5, 4), P(5, 5);
+  const Eigen::Vector2d y = P_SS.llt().solve(Eigen::Vector2d(delta[0], delta[1]));
+  const VectorXd expected = mu0 + Gamma.col(4) * y(0) + Gamma.col(5) * y(1);
+  EXPECT_LT((iv.mean() - expected).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_NEAR(iv.mean()(4) - mu0(4), delta[0], 1e-9);
+  EXPECT_NEAR(iv.mean()(5) - mu0(5), delta[1], 1e-9);
+  EXPECT_GT((iv.mean() - mu0).head(n - 2).cwiseAbs().maxCoeff(), 1e-3);  // the other components move too
+}
+
 TEST(RtsStep, ResetFoldedIntoTransitionDecouplesTheState) {
   // A state reset (fresh variable, docs/fusion.md eq. 12.11) is a transition row of zeros: the smoothed error
   // before the reset is then the regression of that state on the others, and a later correction of the reset
