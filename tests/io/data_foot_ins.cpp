@@ -35,39 +35,26 @@ std::filesystem::path temp_dir(const std::string& name) {
   return d;
 }
 
-TEST(DataFootIns, XioShortLoopClosure) {
-  PEDNAV_REQUIRE_DATA(test::shared_data("foot_xio_ngimu_loops/short_walk.csv"));
-  auto cfg = load_run_config(test::source_path("datasets/foot/xio_short.yaml"));
-  ASSERT_TRUE(cfg) << cfg.error().message;
-  const auto out = temp_dir("xio_short");
-  auto sum = run_run_command(*cfg, (out / "run").string());
-  ASSERT_TRUE(sum) << sum.error().message;
-  EXPECT_TRUE(sum->covariance_healthy);
+// An x-io loop with the committed configuration (detector replaced unless empty): the solution against itself,
+// closure = first-to-last horizontal distance.
+struct XioLoop {
+  double closure_m = 1e9, distance_m = 0.0, closure_pct = 0.0;
+  long zupt_updates = 0;
+  bool covariance_healthy = false;
+};
 
-  CompareArgs args;  // the loop: the solution against itself, closure = first-to-last horizontal distance
-  args.solution = args.reference = (out / "run" / "solution.csv").string();
-  args.out_dir = (out / "cmp").string();
-  args.compare.align = eval::Align::kStart;
-  args.compare.loop = true;
-  auto ev = run_compare(args);
-  ASSERT_TRUE(ev) << ev.error().message;
-  std::printf("[xio short] closure %.3f m of %.1f m (%.2f %%), ZUPT updates %ld\n", ev->closure_m, ev->distance_m,
-              ev->closure_pct_of_distance, static_cast<long>(sum->zupt_updates));
-  EXPECT_LT(ev->closure_m, kXioShortClosureMax_m);
-  EXPECT_GT(ev->distance_m, kXioShortDistanceMin_m);
-  EXPECT_LT(ev->distance_m, kXioShortDistanceMax_m);
-}
-
-// Closure [m] of an x-io loop with the committed configuration and the given detector.
-double xio_closure_m(const std::string& loop, const std::string& detector) {
+XioLoop run_xio_loop(const std::string& loop, const std::string& detector) {
+  XioLoop r;
   auto cfg = load_run_config(test::source_path("datasets/foot/xio_" + loop + ".yaml"));
   EXPECT_TRUE(cfg) << cfg.error().message;
-  if (!cfg) return 1e9;
-  cfg->zupt.detector = detector;
-  const auto out = temp_dir("xio_" + loop + "_" + detector);
+  if (!cfg) return r;
+  if (!detector.empty()) cfg->zupt.detector = detector;
+  const auto out = temp_dir("xio_" + loop + "_" + (detector.empty() ? "configured" : detector));
   auto sum = run_run_command(*cfg, (out / "run").string());
   EXPECT_TRUE(sum) << sum.error().message;
-  if (!sum) return 1e9;
+  if (!sum) return r;
+  r.zupt_updates = static_cast<long>(sum->zupt_updates);
+  r.covariance_healthy = sum->covariance_healthy;
   CompareArgs args;
   args.solution = args.reference = (out / "run" / "solution.csv").string();
   args.out_dir = (out / "cmp").string();
@@ -75,7 +62,22 @@ double xio_closure_m(const std::string& loop, const std::string& detector) {
   args.compare.loop = true;
   auto ev = run_compare(args);
   EXPECT_TRUE(ev) << ev.error().message;
-  return ev ? ev->closure_m : 1e9;
+  if (!ev) return r;
+  r.closure_m = ev->closure_m;
+  r.distance_m = ev->distance_m;
+  r.closure_pct = ev->closure_pct_of_distance;
+  return r;
+}
+
+TEST(DataFootIns, XioShortLoopClosure) {
+  PEDNAV_REQUIRE_DATA(test::shared_data("foot_xio_ngimu_loops/short_walk.csv"));
+  const XioLoop r = run_xio_loop("short", "");
+  EXPECT_TRUE(r.covariance_healthy);
+  std::printf("[xio short] closure %.3f m of %.1f m (%.2f %%), ZUPT updates %ld\n", r.closure_m, r.distance_m,
+              r.closure_pct, r.zupt_updates);
+  EXPECT_LT(r.closure_m, kXioShortClosureMax_m);
+  EXPECT_GT(r.distance_m, kXioShortDistanceMin_m);
+  EXPECT_LT(r.distance_m, kXioShortDistanceMax_m);
 }
 
 // Issue 8: with the HMM detector the end-point error of both x-io loops is no worse than with SHOE at its default
@@ -85,7 +87,7 @@ TEST(DataFootIns, XioHmmClosureIsNoWorseThanShoe) {
   PEDNAV_REQUIRE_DATA(test::shared_data("foot_xio_ngimu_loops/short_walk.csv"));
   PEDNAV_REQUIRE_DATA(test::shared_data("foot_xio_ngimu_loops/long_walk.csv"));
   for (const std::string loop : {"short", "long"}) {
-    const double hmm = xio_closure_m(loop, "hmm"), shoe = xio_closure_m(loop, "shoe");
+    const double hmm = run_xio_loop(loop, "hmm").closure_m, shoe = run_xio_loop(loop, "shoe").closure_m;
     std::printf("[xio %s] closure hmm %.3f m, shoe %.3f m\n", loop.c_str(), hmm, shoe);
     EXPECT_LE(hmm, shoe) << loop;
   }
