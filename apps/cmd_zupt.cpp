@@ -32,7 +32,7 @@ void add_zupt_command(CLI::App& app, Action& action) {
   cmd->add_option("CONFIG", *path, "Run configuration (YAML): imu and zupt sections")->required();
   cmd->add_option("-o,--output", *out, "Output folder (zupt.csv, summary.json)")->required();
   cmd->add_option("--detector", *detector, "Override zupt.detector")
-      ->check(CLI::IsMember({"shoe", "mv", "are", "mag", "hmm"}));
+      ->check(CLI::IsMember({"shoe", "mv", "are", "mag", "hmm", "labels"}));
   cmd->callback([&action, path, out, detector] {
     action = [path, out, detector] {
       auto cfg = io::load_run_config(*path);

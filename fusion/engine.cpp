@@ -1526,7 +1526,14 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
     }
     if (in.base && !o.base_position_e) return make_error("base observations given without a base position");
   }
-  const std::vector<ins::ZuptDecision> decisions = ins::detect_stance(samples, o.zupt);
+  if (o.zupt.detector == "labels") {
+    if (!in.stance_labels || in.stance_labels->empty())
+      return make_error("zupt.detector labels: the IMU log has no stance labels (imu.format: stance: {column: N})");
+    if (in.stance_labels->size() != samples.size())
+      return make_error("zupt.detector labels: " + std::to_string(in.stance_labels->size()) + " stance labels for " +
+                        std::to_string(samples.size()) + " IMU samples");
+  }
+  const std::vector<ins::ZuptDecision> decisions = ins::detect_stance(samples, o.zupt, in.stance_labels);
 
   // Start at the first still period (levelling window): the first stance run of >= 0.2 s.
   size_t s0 = 0, s1 = 0;

@@ -129,6 +129,8 @@ struct EngineInputs {
   const gnss::NavData* nav = nullptr;                 ///< tc only
   const std::vector<gnss::ObsEpoch>* rover = nullptr; ///< tc only
   const std::vector<gnss::ObsEpoch>* base = nullptr;  ///< optional (SD)
+  /// Stance labels, one 0/1 per IMU sample (io::ImuLog::stance): required by `zupt.detector: labels`.
+  const std::vector<uint8_t>* stance_labels = nullptr;
   /// GNSS epochs whose time is in this set are skipped (outage masks); satellites of partial outages removed.
   std::function<void(gnss::ObsEpoch&)> gnss_mask;
   /// Test hook: called at the end of every mechanization step with the step's end time (GPST), after its updates

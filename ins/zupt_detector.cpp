@@ -61,8 +61,9 @@ void drop_stances_right_after_push_off(std::vector<ZuptDecision>& d, const std::
 
 std::vector<std::string> ZuptDetectorOptions::problems() const {
   std::vector<std::string> p;
-  if (detector != "mv" && detector != "shoe" && detector != "are" && detector != "mag" && detector != "hmm") {
-    p.push_back("zupt.detector '" + detector + "' is not mv, shoe, are, mag or hmm");
+  if (detector != "mv" && detector != "shoe" && detector != "are" && detector != "mag" && detector != "hmm" &&
+      detector != "labels") {
+    p.push_back("zupt.detector '" + detector + "' is not mv, shoe, are, mag, hmm or labels");
   }
   if (are_threshold <= 0) p.push_back("zupt.are_threshold must be > 0");
   if (mag_threshold <= 0) p.push_back("zupt.mag_threshold must be > 0");
@@ -297,10 +298,18 @@ std::vector<bool> zupt_update_samples(const std::vector<ZuptDecision>& d, const 
   return ok;
 }
 
-std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& s, const ZuptDetectorOptions& o) {
+std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& s, const ZuptDetectorOptions& o,
+                                        const std::vector<uint8_t>* labels) {
   const int n = static_cast<int>(s.size());
   std::vector<ZuptDecision> d(n);
   if (n == 0) return d;
+  if (o.detector == "labels") {
+    for (int k = 0; k < n; ++k) {
+      d[k].stance = labels && static_cast<size_t>(k) < labels->size() && (*labels)[static_cast<size_t>(k)] != 0;
+      d[k].statistic = d[k].stance ? 1.0 : 0.0;
+    }
+    return d;
+  }
   if (o.detector == "hmm") return detect_gait_hmm(s, o).decisions;
   if (o.detector == "are" || o.detector == "mag") {
     // Skog et al. 2010 eq. 8 (ARE) and 9 (MAG), window W centred on the sample.

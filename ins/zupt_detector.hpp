@@ -2,6 +2,7 @@
 // a whole log (post-processing: windows are centred on the sample they decide). docs/zupt.md.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <utility>
@@ -14,7 +15,9 @@
 namespace pednav::ins {
 
 struct ZuptDetectorOptions {
-  std::string detector = "shoe";    ///< shoe (Skog et al. 2010 GLRT) | mv (seed 004 eq. 1) | are | mag | hmm (seed 002)
+  /// shoe (Skog et al. 2010 GLRT) | mv (seed 004 eq. 1) | are | mag | hmm (seed 002) | labels (given per sample:
+  /// reference or oracle stance labels from the IMU log, to separate detector errors from INS/ZUPT errors)
+  std::string detector = "shoe";
   // Moving variance (seed 004 eq. 1): stance when std(|f|) over the window < threshold AND the time since
   // the current step started exceeds min_time_since_step_s.
   double mv_window_s = 0.05;        ///< variance window [s] (seed 004: 3 samples at 100 Hz ~ 0.03 s)
@@ -104,8 +107,11 @@ HmmDetection detect_gait_hmm(const std::vector<ImuSample>& samples, const ZuptDe
 /// centred on the sample, sigmas shoe_sigma_*; dimensionless.
 std::vector<double> shoe_statistic(const std::vector<ImuSample>& samples, const ZuptDetectorOptions& options);
 
-/// Run the configured detector over time-ordered samples (GPST). Returns one decision per sample.
-std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& samples, const ZuptDetectorOptions& options);
+/// Run the configured detector over time-ordered samples (GPST). Returns one decision per sample. Detector
+/// `labels` copies `labels` (one 0/1 per sample; statistic = the label; a missing label is swing): the caller
+/// checks that the log has them.
+std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& samples, const ZuptDetectorOptions& options,
+                                        const std::vector<uint8_t>* labels = nullptr);
 
 /// Footfalls of a detection, as [first, last] sample indices: the stance runs of `d`, where runs separated only by
 /// samples the HMM decoded as stance (gait_state kStance) are one footfall (refine_hmm_stances may split a decoded

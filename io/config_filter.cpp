@@ -9,7 +9,7 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
   top.number("mechanization_rate_hz", out.mechanization_rate_hz, false, 1e-3, 2000.0);
   {
     YamlMap z = top.map("zupt");
-    z.choice("detector", out.zupt.detector, {"mv", "shoe", "are", "mag", "hmm"});
+    z.choice("detector", out.zupt.detector, {"mv", "shoe", "are", "mag", "hmm", "labels"});
     z.choice("form", out.zupt.form, {"D", "F"});
     ZuptConfig& c = out.zupt;
     z.number("mv_window_s", c.mv_window_s, false, 1e-3, 5.0);

@@ -87,6 +87,10 @@ void read_imu_format(YamlMap& m, ImuFormat& out) {
     a.number("full_scale_g", fs_g, false, 0.0, 1e4);
     out.accel_full_scale = fs_g * kG0;
   }
+  if (m.has("stance")) {
+    YamlMap st = m.map("stance");
+    st.integer("column", out.stance_column, true, 0, 10000);
+  }
   for (int i = 0; i < 3; ++i) {
     if (std::abs(out.gyro_signs(i)) != 1.0) m.problem("gyro", "signs must each be 1 or -1");
     if (std::abs(out.accel_signs(i)) != 1.0) m.problem("accel", "signs must each be 1 or -1");

@@ -73,6 +73,7 @@ std::vector<std::string> ImuFormat::problems() const {
       break;
     }
   }
+  if (stance_column < -1) p.push_back("stance.column: column indices are 0-based and >= 0");
   if (!(max_gap_s > 0.0)) p.push_back("max_gap_s must be > 0");
   if (header_lines < 0) p.push_back("header_lines must be >= 0");
   return p;
@@ -89,7 +90,10 @@ Expected<ImuLog> parse_imu_csv(const char* data, size_t size, const std::string&
   int max_col = use_time ? fmt.time_column : 0;
   for (int c : fmt.gyro_columns) max_col = std::max(max_col, c);
   for (int c : fmt.accel_columns) max_col = std::max(max_col, c);
+  const bool labels = fmt.stance_column >= 0;
+  if (labels) max_col = std::max(max_col, fmt.stance_column);
   std::vector<signed char> slot(max_col + 1, -1);
+  if (labels) slot[fmt.stance_column] = 7;
   if (use_time) slot[fmt.time_column] = 0;
   for (int i = 0; i < 3; ++i) {
     slot[fmt.gyro_columns[i]] = static_cast<signed char>(1 + i);
@@ -109,7 +113,7 @@ Expected<ImuLog> parse_imu_csv(const char* data, size_t size, const std::string&
   long line = 0;
   std::string first_bad_reason;
   long data_index = 0;
-  double vals[7];
+  double vals[8];
   while (p < end) {
     const char* le = static_cast<const char*>(std::memchr(p, '\n', static_cast<size_t>(end - p)));
     if (!le) le = end;
@@ -148,6 +152,12 @@ Expected<ImuLog> parse_imu_csv(const char* data, size_t size, const std::string&
       ok = false;
       if (first_bad_reason.empty())
         first_bad_reason = "only " + std::to_string(col) + " columns (expected at least " + std::to_string(max_col + 1) + ")";
+    }
+    if (ok && labels && vals[7] != 0.0 && vals[7] != 1.0) {
+      ok = false;
+      if (first_bad_reason.empty())
+        first_bad_reason = "stance column " + std::to_string(fmt.stance_column) + " is '" + num(vals[7]) +
+                           "' (expected 0 or 1)";
     }
     const long index = data_index++;
     if (!ok) {
@@ -204,6 +214,7 @@ Expected<ImuLog> parse_imu_csv(const char* data, size_t size, const std::string&
     s.omega_ib_b = g_s;  // mounting applied after increment conversion
     s.f_ib_b = a_s;
     log.samples.push_back(s);
+    if (labels) log.stance.push_back(vals[7] != 0.0 ? 1 : 0);
     raw_gyro.push_back(g_s);
     raw_acc.push_back(a_s);
     lines.push_back(line);

@@ -35,6 +35,9 @@ struct ImuFormat {
   std::string gyro_unit = "rad_per_s";  ///< rad_per_s | deg_per_s | rad | deg   (rad/deg = increments per sample)
   std::string accel_unit = "mps2";      ///< mps2 | g | mps                      (mps = increments per sample)
   Eigen::Matrix3d R_b_s = Eigen::Matrix3d::Identity();  ///< mounting: sensor axes -> IMU body frame
+  /// Optional stance-label column (0 = moving, 1 = stance; e.g. reference or oracle zero-velocity labels), read
+  /// into ImuLog::stance for `zupt.detector: labels`; -1 = none.
+  int stance_column = -1;
   double gyro_full_scale = 0.0;   ///< [rad/s] per axis, 0 = not checked
   double accel_full_scale = 0.0;  ///< [m/s^2] per axis, 0 = not checked
   // Checks.
@@ -77,6 +80,7 @@ struct ImuLogReport {
 /// A loaded IMU log: samples in GPST order, IMU body frame, SI units.
 struct ImuLog {
   std::vector<ins::ImuSample> samples;
+  std::vector<uint8_t> stance;  ///< per kept sample 0/1 when the format has a stance column, else empty
   ImuLogReport report;
 };
 

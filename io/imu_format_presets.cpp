@@ -18,6 +18,7 @@ header_lines: 1
 time: {base: relative, column: 0, unit: s}
 gyro: {columns: [4, 5, 6], unit: rad_per_s, signs: [1, 1, 1]}
 accel: {columns: [1, 2, 3], unit: mps2, signs: [1, 1, 1], full_scale_g: 8}
+stance: {column: 10}   # zv_label: PyShoe's SHOE labels at its per-trial tuned threshold (zupt.detector: labels)
 mounting_rpy_deg: [0, 0, 0]
 max_gap_s: 0.05
 )yaml"},

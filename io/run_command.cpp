@@ -155,6 +155,7 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
 fusion::EngineInputs RunInputs::engine_inputs() const {
   fusion::EngineInputs in;
   in.imu = &imu.samples;
+  if (!imu.stance.empty()) in.stance_labels = &imu.stance;
   if (rover) in.rover = &rover->epochs;
   if (nav) in.nav = &*nav;
   if (base) in.base = &base->epochs;

@@ -16,14 +16,17 @@
 namespace pednav::io {
 namespace {
 
-Expected<std::vector<ins::ImuSample>> read_log(const RunConfig& c) {
+Expected<ImuLog> read_log(const RunConfig& c) {
   if (c.imu.file.empty()) return make_error(c.source_file + ": imu.file: required for zero-velocity detection");
   if (!c.imu.has_format) return make_error(c.source_file + ": imu.format: required (a preset name or a column map)");
   auto imu = read_imu_csv(c.imu.file, c.imu.format);
   if (!imu) return imu.error();
   for (const auto& w : imu->report.warnings) spdlog::warn("{}: {}", c.imu.file, w);
   if (imu->samples.size() < 10) return make_error(c.imu.file + ": fewer than 10 IMU samples");
-  return std::move(imu->samples);
+  if (c.zupt.detector == "labels" && imu->stance.empty())
+    return make_error(c.source_file + ": zupt.detector labels: the IMU log has no stance labels (imu.format: stance: "
+                      "{column: N})");
+  return std::move(*imu);
 }
 
 nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
@@ -40,8 +43,9 @@ nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
 
 Expected<ZuptCommandSummary> run_zupt_command(const RunConfig& c, const std::string& out_dir) {
   const auto wall0 = std::chrono::steady_clock::now();
-  auto samples = read_log(c);
-  if (!samples) return samples.error();
+  auto log = read_log(c);
+  if (!log) return log.error();
+  const std::vector<ins::ImuSample>* samples = &log->samples;
   const ins::ZuptDetectorOptions opt = zupt_detector_options(c.zupt);
   if (auto p = opt.problems(); !p.empty()) return make_error(c.source_file + ": " + p.front());
   ZuptCommandSummary sum;
@@ -66,7 +70,7 @@ Expected<ZuptCommandSummary> run_zupt_command(const RunConfig& c, const std::str
                 {"B", matrix_json(h.model.B)},
                 {"decoder", opt.hmm_decoder}};
   } else {
-    d = ins::detect_stance(*samples, opt);
+    d = ins::detect_stance(*samples, opt, &log->stance);
   }
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
@@ -149,8 +153,9 @@ Expected<HmmModelFile> run_hmm_train_command(const std::vector<RunConfig>& confi
       return make_error(c.source_file + ": zupt.hmm_gyro_axis/hmm_smooth_window_s/hmm_grade_width_deg_per_s differ from " +
                         configs.front().source_file + " (one model needs one observation definition)");
     }
-    auto samples = read_log(c);
-    if (!samples) return samples.error();
+    auto log = read_log(c);
+    if (!log) return log.error();
+    const std::vector<ins::ImuSample>* samples = &log->samples;
     const ins::ZuptDetectorOptions opt = zupt_detector_options(z);
     if (auto p = opt.hmm_observations.problems(); !p.empty()) return make_error(c.source_file + ": zupt." + p.front());
     sequences.push_back(ins::extract_gait_observations(*samples, opt.hmm_observations).symbols());

@@ -115,6 +115,26 @@ TEST(EngineBadInput, TooFewImuSamplesAndBadOptions) {
   EXPECT_THAT(r.error().message, HasSubstr("zupt.sigma_mps must be > 0"));
 }
 
+// zupt.detector labels needs one 0/1 label per IMU sample (io: imu.format stance.column).
+TEST(EngineBadInput, LabelsDetectorWithoutLabelsOrWithTheWrongCount) {
+  const auto imu = imu_log(kT0, 10.0, 0.0);
+  fusion::EngineInputs in;
+  in.imu = &imu;
+  fusion::EngineOptions o;
+  o.mode = fusion::Mode::kInsOnly;
+  o.initial_position_e = kPosition;
+  o.initial_yaw_rad = 0.0;
+  o.zupt.detector = "labels";
+  auto r = fusion::run_forward(in, o);
+  ASSERT_FALSE(r);
+  EXPECT_THAT(r.error().message, HasSubstr("zupt.detector labels: the IMU log has no stance labels"));
+  const std::vector<uint8_t> labels(imu.size() - 3, 1);
+  in.stance_labels = &labels;
+  r = fusion::run_forward(in, o);
+  ASSERT_FALSE(r);
+  EXPECT_THAT(r.error().message, HasSubstr("997 stance labels for 1000 IMU samples"));
+}
+
 TEST(RunConfigBadInput, ZuptFormEIsAConfigError) {
   auto c = io::parse_run_config(
       "mode: tc\nrover_obs: r.obs\nbase_obs: b.obs\nnav: n.rnx\nimu:\n  file: imu.csv\n  format: pyshoe\n"

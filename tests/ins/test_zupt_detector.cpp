@@ -64,7 +64,7 @@ TEST(ZuptDetector, ProblemsAreReported) {
   o.are_threshold = 0;
   auto p = o.problems();
   ASSERT_GE(p.size(), 2u);
-  EXPECT_THAT(p[0], HasSubstr("is not mv, shoe, are, mag or hmm"));
+  EXPECT_THAT(p[0], HasSubstr("is not mv, shoe, are, mag, hmm or labels"));
   EXPECT_THAT(p[1], HasSubstr("zupt.are_threshold must be > 0"));
   o = {};
   o.detector = "hmm";
@@ -113,6 +113,24 @@ Gait synthetic_walk(int cycles) {
     }
   }
   return g;
+}
+
+// Detector `labels` takes the stance from the given per-sample labels, whatever the motion says: here the labels
+// contradict the still/moving log, and the decisions follow the labels; without labels every sample is swing.
+TEST(ZuptDetector, LabelsDetectorFollowsTheLabelsNotTheMotion) {
+  const auto s = still_moving_still();
+  ZuptDetectorOptions o;
+  o.detector = "labels";
+  ASSERT_TRUE(o.problems().empty());
+  std::vector<uint8_t> labels(s.size(), 0);
+  for (size_t k = 250; k < 350; ++k) labels[k] = 1;  // "stance" in the middle of the moving second
+  const auto d = detect_stance(s, o, &labels);
+  ASSERT_EQ(d.size(), s.size());
+  for (size_t k = 0; k < s.size(); ++k) {
+    EXPECT_EQ(d[k].stance, labels[k] != 0) << k;
+    EXPECT_EQ(d[k].statistic, labels[k] != 0 ? 1.0 : 0.0) << k;
+  }
+  for (const auto& x : detect_stance(s, o)) EXPECT_FALSE(x.stance);
 }
 
 TEST(ZuptDetector, HmmFindsEveryStanceOfASyntheticWalk) {

@@ -214,6 +214,41 @@ TEST(ImuCsv, SaturationAndBadFormat) {
   EXPECT_THAT(short_rows.error().message, HasSubstr("only 3 columns (expected at least 7)"));
 }
 
+// An optional stance-label column (zupt.detector labels): one 0/1 per kept sample, aligned with the samples when
+// rows are dropped; any other value makes the row bad, counted, with the reason.
+TEST(ImuCsv, StanceLabelColumnStaysAlignedAndOtherValuesAreBadRows) {
+  std::ostringstream os;
+  os << "t,gx,gy,gz,ax,ay,az,label\n";
+  for (int i = 0; i < 200; ++i) {
+    os << i * 0.01 << ",0,0,0,0,0,-9.80665," << (i % 3 == 0 ? "1" : "0") << "\n";
+    if (i == 50) os << i * 0.01 << ",0,0,0,0,0,-9.80665,0\n";  // duplicate time: dropped with its label
+  }
+  os << "2.0,0,0,0,0,0,-9.80665,2\n2.01,0,0,0,0,0,-9.80665,1\n";
+  ImuFormat f = basic();
+  f.stance_column = 7;
+  auto log = parse(os.str(), f);
+  ASSERT_TRUE(log) << log.error().message;
+  ASSERT_EQ(log->stance.size(), log->samples.size());
+  ASSERT_EQ(log->samples.size(), 201u);
+  for (int i = 0; i < 200; ++i) EXPECT_EQ(log->stance[static_cast<size_t>(i)], i % 3 == 0 ? 1 : 0) << i;
+  EXPECT_EQ(log->stance.back(), 1);
+  EXPECT_EQ(log->report.bad_rows, 1);
+  std::string all;
+  for (const auto& w : log->report.warnings) all += w + "\n";
+  EXPECT_THAT(all, HasSubstr("imu.csv:203: stance column 7 is '2' (expected 0 or 1)"));
+  // Without the column in the format, no labels are read.
+  auto plain = parse(os.str(), basic());
+  ASSERT_TRUE(plain) << plain.error().message;
+  EXPECT_TRUE(plain->stance.empty());
+  // In a config: stance.column must be a column index.
+  auto cfg = parse_run_config(
+      "mode: ins\nimu:\n  file: a.csv\n  format:\n    gyro: {columns: [1, 2, 3]}\n    accel: {columns: [4, 5, 6]}\n"
+      "    stance: {column: -1}\n",
+      "cfg.yaml", "/d");
+  ASSERT_FALSE(cfg);
+  EXPECT_THAT(cfg.error().message, HasSubstr("imu.format.stance.column"));
+}
+
 TEST(ImuFormatPresets, EmbeddedTextEqualsDatasetsFilesAndParses) {
   for (const auto& name : imu_format_preset_names()) {
     std::ifstream in(test::source_path("datasets/imu_formats/" + name + ".yaml"));
