@@ -520,6 +520,7 @@ class Filter {
 
   const ins::ErrorStateLayout& layout() const { return layout_; }
   ins::InsState& x() { return x_; }
+  const ins::InsState& x() const { return x_; }
   const ErrorMatrix& P() const { return P_; }
   double clock(int slot) const { return clock_m_[slot]; }
   double drift() const { return drift_mps_; }
@@ -678,7 +679,8 @@ class Runner {
       : in_(in), o_(o), decisions_(decisions),
         // The w-test threshold depends on the configured probability only: computed once (a bisection on the
         // incomplete gamma function), not at every GNSS epoch.
-        w_test_threshold_(gnss::chi_square_quantile(o.fault_probability, 1)) {
+        w_test_threshold_(gnss::chi_square_quantile(o.fault_probability, 1)),
+        zaru_gate_threshold_(o.zaru_gate_probability > 0.0 ? gnss::chi_square_quantile(o.zaru_gate_probability, 3) : 0.0) {
     if (o.mode == Mode::kTightlyCoupled && in.rover && in.base && o.base_position_e) {
       std::vector<GpsTime> rt, bt;
       for (const auto& e : *in.rover) rt.push_back(e.time);
@@ -829,7 +831,7 @@ class Runner {
       stride_.push(inc.t1.ns(), f.x().nav.p_eb_e - p_before, stance);  // mechanized displacement only (eq. 13.1)
       const bool zupt_now = stance && zupt_ok_[std::min(sample_index, zupt_ok_.size() - 1)];
       if (zupt_now && o_.zupt_updates) {
-        zupt_update(f, inc, prev_zupt);
+        zupt_update(f, inc, prev_zupt, sum);
         ++sum.zupt_updates;
       }
       if (steps) {
@@ -1083,10 +1085,15 @@ class Runner {
   // ZUPT: z = 0 - v_est; form D adds the attitude coupling [v×] (seed 001 eq. 8); ZARU: omega - b_g - omega_ie.
   // ZARU uses the mean (bias-corrected) rate over the interval, only when the whole interval is stance (its start
   // had a ZUPT too, so neither end is at a stance edge).
-  void zupt_update(Filter& f, const ins::ImuIncrement& inc, bool interval_start_stance) {
+  void zupt_update(Filter& f, const ins::ImuIncrement& inc, bool interval_start_stance, EngineSummary& sum) {
     const int n = f.layout().dim();
     const Vector3d v = f.x().nav.v_eb_e;
-    const bool zaru = o_.zaru && interval_start_stance && inc.dt_s > 0.0;
+    bool zaru = o_.zaru && interval_start_stance && inc.dt_s > 0.0;
+    if (zaru && zaru_gate_threshold_ > 0.0 && !zaru_passes_gate(f, inc)) {
+      zaru = false;
+      ++sum.zaru_rejected;
+    }
+    sum.zaru_updates += zaru;
     const int m = zaru ? 6 : 3;
     // Fixed capacity (6 rows): no heap allocation.
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, ins::kMaxErrorDim> H =
@@ -1100,18 +1107,10 @@ class Runner {
     r.head<3>() = -v;
     R.topLeftCorner<3, 3>().diagonal().setConstant(o_.zupt_sigma_mps * o_.zupt_sigma_mps);
     if (zaru) {
-      // Measured rate (corrected by the current bias estimate) should equal the Earth rate in b.
-      const Vector3d omega_ie_b = f.x().nav.R_e_b().transpose() * Vector3d(0, 0, wgs84::kOmegaIE_radps);
-      r.tail<3>() = inc.alpha_b / inc.dt_s - omega_ie_b;  // = true - estimated bias if the foot is still
-      H.block<3, 3>(3, ins::kBiasGyro.offset).setIdentity();
-      // The g-sensitive part δG_g f of the corrected rate (docs/error_state.md eq. 5.4): without it the ZARU would
-      // tell the bias apart from G_g f at rest, and the tilt drift the ZUPTs see would then "observe" G_g.
-      if (const int g = f.g_sensitivity_offset(); g >= 0) {
-        const Vector3d f_b = inc.upsilon_b / inc.dt_s;
-        for (int j = 0; j < 3; ++j) H.block<3, 3>(3, g + 3 * j).diagonal().setConstant(f_b(j));
-      }
-      const double var = o_.zaru_sigma_radps * o_.zaru_sigma_radps / std::max(1, inc.samples);
-      R.bottomRightCorner<3, 3>().diagonal().setConstant(var);
+      Vector3d r_zaru;
+      H.middleRows<3>(3) = zaru_rows(f, inc, r_zaru);
+      r.tail<3>() = r_zaru;
+      R.bottomRightCorner<3, 3>().diagonal().setConstant(zaru_variance(inc));
     }
     const Vector3d v_before = v;
     if (!f.update(r, H, R)) return;
@@ -1121,6 +1120,40 @@ class Runner {
       // the velocity-yaw correlation left by the swing makes the following stance ZUPTs act like form F.
       f.reexpress_velocity_attitude(skew(v_before - f.x().nav.v_eb_e));
     }
+  }
+
+  // ZARU rows: the measured rate (corrected by the current bias estimate) should equal the Earth rate in b; residual
+  // into `r`, Jacobian returned (3 x n).
+  Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3, ins::kMaxErrorDim> zaru_rows(
+      const Filter& f, const ins::ImuIncrement& inc, Vector3d& r) const {
+    Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3, ins::kMaxErrorDim> H =
+        Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3, ins::kMaxErrorDim>::Zero(3, f.layout().dim());
+    const Vector3d omega_ie_b = f.x().nav.R_e_b().transpose() * Vector3d(0, 0, wgs84::kOmegaIE_radps);
+    r = inc.alpha_b / inc.dt_s - omega_ie_b;  // = true - estimated bias if the foot is still
+    H.block<3, 3>(0, ins::kBiasGyro.offset).setIdentity();
+    // The g-sensitive part δG_g f of the corrected rate (docs/error_state.md eq. 5.4): without it the ZARU would
+    // tell the bias apart from G_g f at rest, and the tilt drift the ZUPTs see would then "observe" G_g.
+    if (const int g = f.g_sensitivity_offset(); g >= 0) {
+      const Vector3d f_b = inc.upsilon_b / inc.dt_s;
+      for (int j = 0; j < 3; ++j) H.block<3, 3>(0, g + 3 * j).diagonal().setConstant(f_b(j));
+    }
+    return H;
+  }
+
+  double zaru_variance(const ins::ImuIncrement& inc) const {
+    return o_.zaru_sigma_radps * o_.zaru_sigma_radps / std::max(1, inc.samples);
+  }
+
+  // ZARU innovation gate (docs/fusion.md §5.3): d² = rᵀ S⁻¹ r, S = H P Hᵀ + R, against χ²(3) at zaru_gate_probability.
+  bool zaru_passes_gate(const Filter& f, const ins::ImuIncrement& inc) const {
+    Vector3d r;
+    const auto H = zaru_rows(f, inc, r);
+    Eigen::Matrix3d S = H * f.P() * H.transpose();
+    S.diagonal().array() += zaru_variance(inc);
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(S);
+    if (ldlt.info() != Eigen::Success) return false;
+    const double d2 = r.dot(ldlt.solve(r));
+    return std::isfinite(d2) && d2 <= zaru_gate_threshold_;
   }
 
   // Step-averaged velocity (seed 000 eq. 3): along/cross-track/vertical average velocity of the step vs ΔL/T, applied at the
@@ -1437,6 +1470,7 @@ class Runner {
   const std::vector<ins::ZuptDecision>& decisions_;
   std::vector<bool> zupt_ok_;  // stance samples a ZUPT/ZARU may use (zupt_edge_s trimmed; ins::zupt_update_samples)
   const double w_test_threshold_;  // chi2(1) quantile at o_.fault_probability
+  const double zaru_gate_threshold_;  // chi2(3) quantile at o_.zaru_gate_probability; 0 = no gate
   ins::SaturationRepair saturation_;  // clipped samples repaired once per run (docs/ins.md §9)
   StrideVelocity stride_;             // stride-average foot velocity: the antenna velocity (docs/fusion.md §13)
   std::vector<gnss::BaseMatch> matches_;
@@ -1502,6 +1536,8 @@ std::vector<std::string> EngineOptions::problems() const {
   if (!(output_rate_hz > 0)) p.push_back("output.rate_hz must be > 0");
   if (!(zupt_sigma_mps > 0)) p.push_back("zupt.sigma_mps must be > 0");
   if (!(fault_probability > 0.5 && fault_probability < 1.0)) p.push_back("fault_rejection.probability must be in (0.5, 1)");
+  if (!(zaru_gate_probability == 0.0 || (zaru_gate_probability > 0.5 && zaru_gate_probability < 1.0)))
+    p.push_back("zupt.zaru_gate_probability must be 0 (no gate) or in (0.5, 1)");
   for (const auto& s : spec.problems()) p.push_back("imu.spec: " + s);
 
   return p;

@@ -40,6 +40,11 @@ struct EngineOptions {
   double zupt_edge_s = 0.02;            ///< ZUPT/ZARU skip the first and last zupt_edge_s of each stance (docs/zupt.md §5)
   bool zaru = true;                     ///< zero angular-rate update during stance (mean rate of an all-stance interval)
   double zaru_sigma_radps = 0.01;       ///< [rad/s]
+  /// ZARU innovation gate: the ZARU rows of an update are dropped when their normalized innovation exceeds the
+  /// χ²(3) quantile at this probability — a foot that still rolls during a detected stance (heel-to-toe at
+  /// 0.3–1 rad/s) is not at zero rate, and a ZARU would turn that rotation into a gyro bias. 0 = no gate (the
+  /// default: on the x-io loops the gate costs more than it saves; docs/fusion.md §5.3, docs/results.md).
+  double zaru_gate_probability = 0.0;
   bool zupt_updates = true;             ///< false: the detector only segments steps (step-velocity-only aiding)
   StepVelocityOptions step_velocity;    ///< seed 000 step-averaged velocity aiding (fusion/step_velocity.hpp)
   // Initial state.
@@ -169,6 +174,8 @@ struct EngineSummary {
   long mechanization_steps = 0;
   long zupt_updates = 0;
   long zupt_samples = 0;             ///< samples flagged as stance by the detector
+  long zaru_updates = 0;             ///< ZUPTs that carried ZARU rows
+  long zaru_rejected = 0;            ///< ZARU rows dropped by the innovation gate (zaru_gate_probability)
   long step_velocity_updates = 0;    ///< seed 000 step-velocity updates applied
   long gnss_epochs = 0;              ///< rover epochs read
   long gnss_epochs_used = 0;         ///< epochs with at least one accepted measurement

@@ -97,6 +97,7 @@ struct ZuptConfig {
   double edge_s = 0.02;                   ///< ZUPT/ZARU skip the first and last edge_s of each stance (docs/zupt.md §5)
   bool zaru = true;
   double zaru_sigma_radps = 0.01;         ///< key zaru_sigma_deg_per_s
+  double zaru_gate_probability = 0.0;     ///< ZARU innovation gate, χ²(3) quantile probability; 0 = no gate
 };
 
 /// `initial:` section (pednav run).

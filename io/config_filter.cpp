@@ -32,6 +32,9 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
     double zs = c.zaru_sigma_radps * kRadToDeg;
     z.number("zaru_sigma_deg_per_s", zs, false, 1e-9, 100.0);
     c.zaru_sigma_radps = zs * kDegToRad;
+    z.number("zaru_gate_probability", c.zaru_gate_probability, false, 0.0, 0.999999);
+    if (c.zaru_gate_probability > 0.0 && c.zaru_gate_probability <= 0.5)
+      z.problem("zaru_gate_probability", "must be 0 (no gate) or in (0.5, 1)");
   }
   {
     YamlMap i = top.map("initial");

@@ -103,6 +103,7 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.zupt_edge_s = c.zupt.edge_s;
   o.zaru = c.zupt.zaru;
   o.zaru_sigma_radps = c.zupt.zaru_sigma_radps;
+  o.zaru_gate_probability = c.zupt.zaru_gate_probability;
   o.initial_position_e = c.initial.position_e;
   o.initial_yaw_rad = c.initial.yaw_rad;
   o.heading_init_distance_m = c.initial.heading_init_distance_m;
@@ -318,7 +319,8 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
     j["imu_estimate"] = e;
   }
   j["zupt"] = {{"detector", c.zupt.detector}, {"form", c.zupt.form}, {"updates", sum.zupt_updates},
-               {"stance_samples", sum.zupt_samples}};
+               {"stance_samples", sum.zupt_samples}, {"zaru_updates", sum.zaru_updates},
+               {"zaru_rejected_by_gate", sum.zaru_rejected}};
   if (opt.mode == fusion::Mode::kTightlyCoupled) {
     j["gnss"] = {{"epochs_read", sum.gnss_epochs},
                  {"epochs_used", sum.gnss_epochs_used},

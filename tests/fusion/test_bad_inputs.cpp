@@ -144,6 +144,17 @@ TEST(RunConfigBadInput, ZuptFormEIsAConfigError) {
   EXPECT_THAT(c.error().message, HasSubstr("run.yaml:9: zupt.form: expected one of {D, F}, got 'E'"));
 }
 
+TEST(RunConfigBadInput, ZaruGateProbabilityOutsideItsRange) {
+  auto c = io::parse_run_config(
+      "mode: ins\nimu:\n  file: imu.csv\n  format: pyshoe\nzupt:\n  zaru_gate_probability: 0.3\n", "run.yaml", "/data");
+  ASSERT_FALSE(c);
+  EXPECT_THAT(c.error().message, HasSubstr("zupt.zaru_gate_probability: must be 0 (no gate) or in (0.5, 1)"));
+  fusion::EngineOptions o;
+  o.zaru_gate_probability = 1.0;
+  ASSERT_FALSE(o.problems().empty());
+  EXPECT_THAT(o.problems().back(), HasSubstr("zupt.zaru_gate_probability must be 0 (no gate) or in (0.5, 1)"));
+}
+
 TEST(RunCommandBadInput, ImuLogWithoutAStillPeriodNamesTheConfig) {
   const auto dir = std::filesystem::temp_directory_path() / ("pednav_test_fusion_bad_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);

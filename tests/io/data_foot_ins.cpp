@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "io/compare_command.hpp"
 #include "io/config.hpp"
@@ -24,12 +25,17 @@ constexpr double kXioShortClosureMax_m = 0.15;
 // Path length of the solution: measured 25.8 m (29.9 m before §5.5; x-io README: about 25 m); a detector that loses stances inflates it.
 constexpr double kXioShortDistanceMin_m = 20.0;
 constexpr double kXioShortDistanceMax_m = 40.0;
-// PyShoe 2018-02-09-11-19-39, same configuration: mean horizontal error measured 0.126 m (0.099 m before the
-// session-17/18 detector changes, 0.36 m without §5.5; PyShoe tuned: 0.047 m).
+// PyShoe 2018-02-09-11-19-39, same configuration: mean horizontal error measured 0.114 m (0.126 m without the ZARU
+// gate of docs/fusion.md §5.3, 0.099 m before the session-17/18 detector changes, 0.36 m without §5.5; PyShoe
+// tuned: 0.047 m).
 constexpr double kPyshoeMeanMax_m = 0.13;
-// The same trial with PyShoe's own stance labels (zupt.detector labels): measured 0.154 m (RMS 0.202, max 0.471 m),
-// worse than pednav's own gait-adaptive SHOE on this trial: the gap to PyShoe's 0.047 m is not the detector.
-constexpr double kPyshoeLabelsMeanMax_m = 0.19;
+// PyShoe 2017-11-22-11-22-03 (walking): measured 0.091 m; 0.330 m without the ZARU gate, so the bound fails without
+// it (PyShoe tuned: 0.045 m).
+constexpr double kPyshoeWalkMeanMax_m = 0.13;
+// The same trial with PyShoe's own stance labels (zupt.detector labels): measured 0.145 m (RMS 0.188, max 0.438 m;
+// 0.154 m without the ZARU gate), worse than pednav's own gait-adaptive SHOE on this trial: the gap to PyShoe's
+// 0.047 m is not the detector.
+constexpr double kPyshoeLabelsMeanMax_m = 0.18;
 
 std::filesystem::path temp_dir(const std::string& name) {
   const auto d = std::filesystem::temp_directory_path() / ("pednav_data_foot_ins_" + name);
@@ -151,11 +157,13 @@ PyshoeTrial run_pyshoe_trial(const std::string& trial, const std::string& detect
 }
 
 TEST(DataFootIns, PyshoeTrialMeanError) {
-  const std::string trial = "2018-02-09-11-19-39";
-  PEDNAV_REQUIRE_DATA(test::shared_data("foot_pyshoe_vicon/csv/" + trial + ".csv"));
-  const PyshoeTrial r = run_pyshoe_trial(trial, "");
-  EXPECT_LT(r.mean_m, kPyshoeMeanMax_m);
-  EXPECT_GT(r.epochs, 500);
+  for (const auto& [trial, bound_m] : {std::pair<std::string, double>{"2018-02-09-11-19-39", kPyshoeMeanMax_m},
+                                       std::pair<std::string, double>{"2017-11-22-11-22-03", kPyshoeWalkMeanMax_m}}) {
+    PEDNAV_REQUIRE_DATA(test::shared_data("foot_pyshoe_vicon/csv/" + trial + ".csv"));
+    const PyshoeTrial r = run_pyshoe_trial(trial, "");
+    EXPECT_LT(r.mean_m, bound_m) << trial;
+    EXPECT_GT(r.epochs, 500) << trial;
+  }
 }
 
 // zupt.detector labels with the pyshoe format's stance column: the stance is exactly PyShoe's stored labels (its
