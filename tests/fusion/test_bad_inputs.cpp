@@ -37,6 +37,15 @@ std::vector<ins::ImuSample> imu_log(GpsTime t0, double duration_s, double spin_r
 const GpsTime kT0 = GpsTime::from_week_tow(2300, 100000.0);
 const Eigen::Vector3d kPosition = ecef_from_geodetic(Geodetic{51.08 * kDegToRad, -114.13 * kDegToRad, 1050.0});
 
+// mode ins with the initial position and heading given: what is left to fail is the input under test.
+fusion::EngineOptions ins_options() {
+  fusion::EngineOptions o;
+  o.mode = fusion::Mode::kInsOnly;
+  o.initial_position_e = kPosition;
+  o.initial_yaw_rad = 0.0;
+  return o;
+}
+
 TEST(EngineBadInput, GnssAndImuSpansThatDoNotOverlap) {
   const auto imu = imu_log(kT0, 60.0, 0.0);
   std::vector<gnss::ObsEpoch> rover(3);
@@ -58,10 +67,7 @@ TEST(EngineBadInput, ImuWithoutAStillPeriod) {
   const auto imu = imu_log(kT0, 30.0, 3.0);  // spinning at 3 rad/s the whole time
   fusion::EngineInputs in;
   in.imu = &imu;
-  fusion::EngineOptions o;
-  o.mode = fusion::Mode::kInsOnly;
-  o.initial_position_e = kPosition;
-  o.initial_yaw_rad = 0.0;
+  fusion::EngineOptions o = ins_options();
   auto r = fusion::run_forward(in, o);
   ASSERT_FALSE(r);
   EXPECT_THAT(r.error().message, HasSubstr("no still period found"));
@@ -120,10 +126,7 @@ TEST(EngineBadInput, LabelsDetectorWithoutLabelsOrWithTheWrongCount) {
   const auto imu = imu_log(kT0, 10.0, 0.0);
   fusion::EngineInputs in;
   in.imu = &imu;
-  fusion::EngineOptions o;
-  o.mode = fusion::Mode::kInsOnly;
-  o.initial_position_e = kPosition;
-  o.initial_yaw_rad = 0.0;
+  fusion::EngineOptions o = ins_options();
   o.zupt.detector = "labels";
   auto r = fusion::run_forward(in, o);
   ASSERT_FALSE(r);
