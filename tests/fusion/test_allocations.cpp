@@ -65,6 +65,7 @@ void check_no_allocation_per_step(bool states) {
   if (states) {
     o.multipath_sigma_m = file->scenario.gnss.multipath_sigma_m;
     o.estimate_scale_factors = true;
+    o.zaru_gate_probability = 0.999;  // the gate's S = H P Hᵀ + R on fixed-capacity matrices too
   } else {
     o.multipath_sigma_m = 0.0;  // white code errors (the multipath states are on by default since session 4)
   }
@@ -117,12 +118,13 @@ void check_no_allocation_per_step(bool states) {
   EXPECT_EQ(allocations, 0);
   if (states) {
     EXPECT_GT(r->summary.multipath_resets, 0);
+    EXPECT_GT(r->summary.zaru_updates, 0);
   }
 }
 
 TEST(Allocations, NoHeapAllocationPerMechanizationStepOrGnssEpoch) { check_no_allocation_per_step(false); }
 
-TEST(Allocations, NoHeapAllocationWithMultipathAndScaleFactorStates) { check_no_allocation_per_step(true); }
+TEST(Allocations, NoHeapAllocationWithMultipathAndScaleFactorStatesAndTheZaruGate) { check_no_allocation_per_step(true); }
 
 }  // namespace
 }  // namespace pednav
