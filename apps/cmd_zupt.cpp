@@ -48,6 +48,10 @@ void add_zupt_command(CLI::App& app, Action& action) {
       }
       spdlog::info("zupt ({}): {} of {} samples stance in {} intervals, {} steps, {:.2f} s -> {}", sum->detector,
                    sum->stance_samples, sum->samples, sum->stance_intervals, sum->steps, sum->wall_s, *out);
+      if (sum->label_stance_samples >= 0) {
+        spdlog::info("against the log's {} labelled stance samples: precision {:.3f}, recall {:.3f}",
+                     sum->label_stance_samples, sum->label_precision, sum->label_recall);
+      }
       if (sum->detector == "hmm") {
         spdlog::info("hmm: {} observations, {} Baum-Welch iterations on the log; transition matrix A (rows "
                      "from, columns to A B C D):\n{}",

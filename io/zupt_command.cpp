@@ -95,6 +95,21 @@ Expected<ZuptCommandSummary> run_zupt_command(const RunConfig& c, const std::str
     sum.stance_intervals += d[k].stance && (k == 0 || !d[k - 1].stance);
   }
   sum.steps = static_cast<long>(ins::stance_phases(d).size());
+  if (!log->stance.empty()) {
+    long tp = 0, fp = 0, fn = 0;
+    for (std::size_t k = 0; k < d.size(); ++k) {
+      const bool label = log->stance[k] != 0;
+      tp += d[k].stance && label;
+      fp += d[k].stance && !label;
+      fn += !d[k].stance && label;
+    }
+    sum.label_stance_samples = tp + fn;
+    sum.label_precision = tp + fp > 0 ? static_cast<double>(tp) / static_cast<double>(tp + fp) : 0.0;
+    sum.label_recall = tp + fn > 0 ? static_cast<double>(tp) / static_cast<double>(tp + fn) : 0.0;
+    j["log_labels"] = {{"stance_samples", sum.label_stance_samples},
+                       {"precision", sum.label_precision},
+                       {"recall", sum.label_recall}};
+  }
   sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   j["detector"] = sum.detector;
   j["imu_file"] = c.imu.file;

@@ -22,6 +22,11 @@ struct ZuptCommandSummary {
   long hmm_observations = 0;        ///< hmm only: length of the observation sequence
   int hmm_iterations = 0;           ///< hmm only: Baum-Welch iterations on the log
   ins::HmmModel hmm_model;          ///< hmm only: the model used for decoding
+  /// When the log has a stance-label column (imu.format stance.column): the detector's stance samples scored against
+  /// the labels — precision = TP / (TP + FP), recall = TP / (TP + FN) over all samples; -1 without labels.
+  long label_stance_samples = -1;
+  double label_precision = -1.0;
+  double label_recall = -1.0;
   double wall_s = 0.0;
 };
 
