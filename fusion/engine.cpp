@@ -1089,9 +1089,14 @@ class Runner {
     const int n = f.layout().dim();
     const Vector3d v = f.x().nav.v_eb_e;
     bool zaru = o_.zaru && interval_start_stance && inc.dt_s > 0.0;
-    if (zaru && zaru_gate_threshold_ > 0.0 && !zaru_passes_gate(f, inc)) {
-      zaru = false;
-      ++sum.zaru_rejected;
+    Vector3d r_zaru = Vector3d::Zero();
+    Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3, ins::kMaxErrorDim> H_zaru;
+    if (zaru) {
+      H_zaru = zaru_rows(f, inc, r_zaru);
+      if (zaru_gate_threshold_ > 0.0 && !zaru_passes_gate(f, H_zaru, r_zaru, zaru_variance(inc))) {
+        zaru = false;
+        ++sum.zaru_rejected;
+      }
     }
     sum.zaru_updates += zaru;
     const int m = zaru ? 6 : 3;
@@ -1107,8 +1112,7 @@ class Runner {
     r.head<3>() = -v;
     R.topLeftCorner<3, 3>().diagonal().setConstant(o_.zupt_sigma_mps * o_.zupt_sigma_mps);
     if (zaru) {
-      Vector3d r_zaru;
-      H.middleRows<3>(3) = zaru_rows(f, inc, r_zaru);
+      H.middleRows<3>(3) = H_zaru;
       r.tail<3>() = r_zaru;
       R.bottomRightCorner<3, 3>().diagonal().setConstant(zaru_variance(inc));
     }
@@ -1145,11 +1149,11 @@ class Runner {
   }
 
   // ZARU innovation gate (docs/fusion.md §5.3): d² = rᵀ S⁻¹ r, S = H P Hᵀ + R, against χ²(3) at zaru_gate_probability.
-  bool zaru_passes_gate(const Filter& f, const ins::ImuIncrement& inc) const {
-    Vector3d r;
-    const auto H = zaru_rows(f, inc, r);
+  bool zaru_passes_gate(const Filter& f, const Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3,
+                                                             ins::kMaxErrorDim>& H,
+                        const Vector3d& r, double variance) const {
     Eigen::Matrix3d S = H * f.P() * H.transpose();
-    S.diagonal().array() += zaru_variance(inc);
+    S.diagonal().array() += variance;
     const Eigen::LDLT<Eigen::Matrix3d> ldlt(S);
     if (ldlt.info() != Eigen::Success) return false;
     const double d2 = r.dot(ldlt.solve(r));
@@ -1562,13 +1566,7 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
     }
     if (in.base && !o.base_position_e) return make_error("base observations given without a base position");
   }
-  if (o.zupt.detector == "labels") {
-    if (!in.stance_labels || in.stance_labels->empty())
-      return make_error("zupt.detector labels: the IMU log has no stance labels (imu.format: stance: {column: N})");
-    if (in.stance_labels->size() != samples.size())
-      return make_error("zupt.detector labels: " + std::to_string(in.stance_labels->size()) + " stance labels for " +
-                        std::to_string(samples.size()) + " IMU samples");
-  }
+  if (auto p = ins::stance_label_problem(o.zupt, in.stance_labels, samples.size()); !p.empty()) return make_error(p);
   const std::vector<ins::ZuptDecision> decisions = ins::detect_stance(samples, o.zupt, in.stance_labels);
 
   // Start at the first still period (levelling window): the first stance run of >= 0.2 s.

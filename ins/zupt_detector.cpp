@@ -298,6 +298,16 @@ std::vector<bool> zupt_update_samples(const std::vector<ZuptDecision>& d, const 
   return ok;
 }
 
+std::string stance_label_problem(const ZuptDetectorOptions& o, const std::vector<uint8_t>* labels, size_t n_samples) {
+  if (o.detector != "labels") return {};
+  if (!labels || labels->empty())
+    return "zupt.detector labels: the IMU log has no stance labels (imu.format: stance: {column: N})";
+  if (labels->size() != n_samples)
+    return "zupt.detector labels: " + std::to_string(labels->size()) + " stance labels for " +
+           std::to_string(n_samples) + " IMU samples";
+  return {};
+}
+
 std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& s, const ZuptDetectorOptions& o,
                                         const std::vector<uint8_t>* labels) {
   const int n = static_cast<int>(s.size());

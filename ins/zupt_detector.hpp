@@ -113,6 +113,11 @@ std::vector<double> shoe_statistic(const std::vector<ImuSample>& samples, const 
 std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& samples, const ZuptDetectorOptions& options,
                                         const std::vector<uint8_t>* labels = nullptr);
 
+/// Why `labels` cannot be the stance of `n_samples` samples for detector `labels` (none, or a different count);
+/// empty when they can or the detector is another one.
+std::string stance_label_problem(const ZuptDetectorOptions& options, const std::vector<uint8_t>* labels,
+                                 size_t n_samples);
+
 /// Footfalls of a detection, as [first, last] sample indices: the stance runs of `d`, where runs separated only by
 /// samples the HMM decoded as stance (gait_state kStance) are one footfall (refine_hmm_stances may split a decoded
 /// stance into its still parts). Without HMM states (other detectors) these are the stance runs themselves.

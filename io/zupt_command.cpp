@@ -23,9 +23,6 @@ Expected<ImuLog> read_log(const RunConfig& c) {
   if (!imu) return imu.error();
   for (const auto& w : imu->report.warnings) spdlog::warn("{}: {}", c.imu.file, w);
   if (imu->samples.size() < 10) return make_error(c.imu.file + ": fewer than 10 IMU samples");
-  if (c.zupt.detector == "labels" && imu->stance.empty())
-    return make_error(c.source_file + ": zupt.detector labels: the IMU log has no stance labels (imu.format: stance: "
-                      "{column: N})");
   return std::move(*imu);
 }
 
@@ -48,6 +45,8 @@ Expected<ZuptCommandSummary> run_zupt_command(const RunConfig& c, const std::str
   const std::vector<ins::ImuSample>* samples = &log->samples;
   const ins::ZuptDetectorOptions opt = zupt_detector_options(c.zupt);
   if (auto p = opt.problems(); !p.empty()) return make_error(c.source_file + ": " + p.front());
+  if (auto p = ins::stance_label_problem(opt, &log->stance, samples->size()); !p.empty())
+    return make_error(c.source_file + ": " + p);
   ZuptCommandSummary sum;
   sum.detector = opt.detector;
   std::vector<ins::ZuptDecision> d;
