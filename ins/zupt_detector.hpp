@@ -34,6 +34,10 @@ struct ZuptDetectorOptions {
   double shoe_adaptive_factor = 0.0;
   double shoe_adaptive_window_s = 0.6;  ///< about half a gait cycle either side at a fast gait [s]
   double shoe_adaptive_max = 1000.0;    ///< largest stance minimum of T accepted (|ω| about 3 rad/s at σω 0.1 rad/s)
+  /// The threshold is raised only where the same window holds a swing: max |ω| over it >= this [rad/s]. A foot that
+  /// never gets still between vigorous swings is a fast gait's stance; slow motion without swings (pivoting, crawling,
+  /// shuffling) is not, and keeps γ (docs/zupt.md §1). <= 0: no condition.
+  double shoe_adaptive_min_peak_radps = 0.0;
   // ARE and MAG (Skog et al. 2010 eq. 8, 9), same window W and sigmas as SHOE:
   // ARE T = 1/(σω² W) Σ|ω|² < γ_are; MAG T = 1/(σa² W) Σ(|f| - g)² < γ_mag.
   double are_threshold = 10.0;      ///< γ_are (10 with σω 0.1 rad/s: RMS rate below 0.32 rad/s)

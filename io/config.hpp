@@ -93,6 +93,7 @@ struct ZuptConfig {
   double hmm_refine_factor = 0.0;         ///< stance shortening by SHOE, adaptive threshold (0: off)
   double shoe_adaptive_factor = 0.0;      ///< gait-adaptive SHOE threshold factor (0: off; ins::ZuptDetectorOptions)
   double shoe_adaptive_window_s = 0.6;
+  double shoe_adaptive_min_peak_radps = 0.0;  ///< key shoe_adaptive_min_peak_rate_deg_per_s (0: no condition)
   double sigma_mps = 0.02;                ///< ZUPT measurement noise per axis
   double edge_s = 0.02;                   ///< ZUPT/ZARU skip the first and last edge_s of each stance (docs/zupt.md §5)
   bool zaru = true;

@@ -172,6 +172,9 @@ void read_zupt_hmm_keys(YamlMap& z, ZuptConfig& c) {
   z.number("hmm_refine_factor", c.hmm_refine_factor, false, 0.0, 1e6);
   z.number("shoe_adaptive_factor", c.shoe_adaptive_factor, false, 0.0, 1e6);
   z.number("shoe_adaptive_window_s", c.shoe_adaptive_window_s, false, 0.0, 10.0);
+  double peak = c.shoe_adaptive_min_peak_radps * kRadToDeg;
+  z.number("shoe_adaptive_min_peak_rate_deg_per_s", peak, false, 0.0, 1e5);
+  c.shoe_adaptive_min_peak_radps = peak * kDegToRad;
   z.path("hmm_model", c.hmm_model_file);
   if (!c.hmm_model_file.empty()) {
     auto m = read_hmm_model(c.hmm_model_file);
@@ -226,6 +229,7 @@ ins::ZuptDetectorOptions zupt_detector_options(const ZuptConfig& c) {
   o.hmm_refine_factor = c.hmm_refine_factor;
   o.shoe_adaptive_factor = c.shoe_adaptive_factor;
   o.shoe_adaptive_window_s = c.shoe_adaptive_window_s;
+  o.shoe_adaptive_min_peak_radps = c.shoe_adaptive_min_peak_radps;
   return o;
 }
 

@@ -9,6 +9,7 @@
 #include "core/geodesy.hpp"
 #include "fusion/engine.hpp"
 #include "io/config.hpp"
+#include "io/hmm_model_io.hpp"
 #include "io/run_command.hpp"
 
 namespace pednav {
@@ -156,6 +157,17 @@ TEST(RunConfigBadInput, ZaruGateProbabilityOutsideItsRange) {
   o.zaru_gate_probability = 1.0;
   ASSERT_FALSE(o.problems().empty());
   EXPECT_THAT(o.problems().back(), HasSubstr("zupt.zaru_gate_probability must be 0 (no gate) or in (0.5, 1)"));
+}
+
+TEST(RunConfigBadInput, ShoeAdaptivePeakRateIsDegreesPerSecondAndNotNegative) {
+  const std::string head = "mode: ins\nimu:\n  file: imu.csv\n  format: pyshoe\nzupt:\n";
+  auto ok = io::parse_run_config(head + "  shoe_adaptive_min_peak_rate_deg_per_s: 180\n", "run.yaml", "/data");
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_NEAR(io::zupt_detector_options(ok->zupt).shoe_adaptive_min_peak_radps, 3.14159265358979, 1e-12);
+  auto bad = io::parse_run_config(head + "  shoe_adaptive_min_peak_rate_deg_per_s: -5\n", "run.yaml", "/data");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message,
+              HasSubstr("run.yaml:6: zupt.shoe_adaptive_min_peak_rate_deg_per_s: value -5 is out of range"));
 }
 
 TEST(RunCommandBadInput, ImuLogWithoutAStillPeriodNamesTheConfig) {

@@ -259,6 +259,39 @@ TEST(ZuptDetector, HmmRefineThresholdAdaptsToAFootThatNeverStops) {
   EXPECT_LE(a.rolling, 8 * g.stances);
 }
 
+// shoe_adaptive_min_peak_radps: the gait-adaptive threshold is raised only where a swing is near. A slow pivot (0.5
+// rad/s for 2 s between two rests, SHOE T = 25 > γ = 10) is stance for the unconditioned adaptive SHOE (threshold
+// 3 × 25 where no rest is within ±0.5 s: the PyShoe 2018 trial's slow motion), not with the peak condition; the fast
+// gait whose flat foot never stops is decided as without it (swing peak 7 rad/s).
+TEST(ZuptDetector, ShoeAdaptiveThresholdIsRaisedOnlyNearASwing) {
+  std::vector<ImuSample> s;
+  for (int k = 0; k < 800; ++k) {
+    ImuSample x;
+    x.t = GpsTime::from_week_tow(0, k / kRate_hz);
+    x.f_ib_b = Eigen::Vector3d(0, 0, -9.80665);
+    if (k >= 200 && k < 600) x.omega_ib_b = Eigen::Vector3d(0, 0, 0.5);
+    s.push_back(x);
+  }
+  ZuptDetectorOptions o;
+  o.detector = "shoe";
+  o.shoe_adaptive_factor = 3.0;
+  o.shoe_adaptive_window_s = 1.0;
+  constexpr int kMidPivot = 400;  // 1 s from either rest
+  EXPECT_TRUE(detect_stance(s, o)[kMidPivot].stance);
+  o.shoe_adaptive_min_peak_radps = kPi;  // 180 °/s
+  const auto d = detect_stance(s, o);
+  EXPECT_EQ(std::count_if(d.begin() + 200, d.begin() + 600, [](const ZuptDecision& z) { return z.stance; }), 0);
+  EXPECT_TRUE(d[100].stance);  // the rests stay stance
+  EXPECT_TRUE(d[700].stance);
+  // The fast gait: every decision the same with and without the condition (stance found where the foot never stops).
+  const Gait g = rolling_walk(12, 0.6);
+  const auto with_peak = detect_stance(g.samples, o);
+  o.shoe_adaptive_min_peak_radps = 0.0;
+  const auto without = detect_stance(g.samples, o);
+  EXPECT_GE(count(g, with_peak).runs, g.stances);
+  for (std::size_t k = 0; k < without.size(); ++k) ASSERT_EQ(with_peak[k].stance, without[k].stance) << k;
+}
+
 // 100 Hz samples and decisions from a gait string (D = stance, A = push-off, B = swing, C = heel strike, other
 // characters: a non-stance flicker decoded as D).
 void gait_from_string(const char* gait, std::vector<ImuSample>& s, std::vector<ZuptDecision>& d) {

@@ -1,15 +1,18 @@
 // INS/ZUPT (`mode: ins`) on real foot data with the committed configurations of datasets/foot/ (issue 5):
-// x-io short loop closure, and the mean start-aligned horizontal error of one PyShoe Vicon trial. The bounds are the
-// figures measured when the test was written (docs/results.md "INS/ZUPT on real foot data (issue 5)") plus a
-// margin, so a regression shows; they are NOT the issue's targets, which pednav does not meet yet.
+// x-io short loop closure, the mean start-aligned horizontal error of the four PyShoe Vicon trials, and the error of
+// LORD #35 at its footprints. The bounds are the figures measured when the test was written (docs/results.md) plus a
+// margin, so a regression shows; only PyShoe trial 2's bound is the issue's target (the others are not met yet).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "io/compare_command.hpp"
 #include "io/config.hpp"
@@ -25,17 +28,21 @@ constexpr double kXioShortClosureMax_m = 0.15;
 // Path length of the solution: measured 25.8 m (29.9 m before §5.5; x-io README: about 25 m); a detector that loses stances inflates it.
 constexpr double kXioShortDistanceMin_m = 20.0;
 constexpr double kXioShortDistanceMax_m = 40.0;
-// PyShoe 2018-02-09-11-19-39, same configuration: mean horizontal error measured 0.114 m (0.126 m without the ZARU
-// gate of docs/fusion.md §5.3, 0.099 m before the session-17/18 detector changes, 0.36 m without §5.5; PyShoe
-// tuned: 0.047 m).
+// PyShoe trials, same configuration (one for the GX5-25: PyShoe's process noise, gait-adaptive SHOE α 3 next to a
+// swing, ZARU gate; docs/results.md "Session 21"), mean horizontal error after start alignment. Measured 0.062 /
+// 0.119 / 0.128 / 0.106 m (PyShoe tuned per trial: 0.045 / 0.132 / 0.112 / 0.047 m). Before session 21 (data-sheet
+// noise, α 2, no swing condition): 0.091 / 0.613 / 2.781 / 0.114 m; with the new noise but no swing condition trial 4
+// is 0.642 m, so each bound fails without the change it guards.
+constexpr double kPyshoeWalk1MeanMax_m = 0.08;
+constexpr double kPyshoeWalk2MeanMax_m = 0.132;  // PyShoe's own tuned figure: met
+constexpr double kPyshoeRunMeanMax_m = 0.16;
 constexpr double kPyshoeMeanMax_m = 0.13;
-// PyShoe 2017-11-22-11-22-03 (walking): measured 0.091 m; 0.330 m without the ZARU gate, so the bound fails without
-// it (PyShoe tuned: 0.045 m).
-constexpr double kPyshoeWalkMeanMax_m = 0.13;
-// The same trial with PyShoe's own stance labels (zupt.detector labels): measured 0.145 m (RMS 0.188, max 0.438 m;
-// 0.154 m without the ZARU gate), worse than pednav's own gait-adaptive SHOE on this trial: the gap to PyShoe's
-// 0.047 m is not the detector.
-constexpr double kPyshoeLabelsMeanMax_m = 0.18;
+// The 2018 trial with PyShoe's own stance labels (zupt.detector labels): measured 0.045 m (RMS 0.057, max 0.160 m),
+// i.e. PyShoe's 0.047 m with its stances; 0.145 m with the data-sheet process noise.
+constexpr double kPyshoeLabelsMeanMax_m = 0.06;
+// LORD #35 (fast walk, 29 footprints), same GX5-25 configuration: RMS error at the footprints measured 1.49 m, final
+// 2.7 % of the path; 31.6 m before session 21 (the stance of a fast step never got below the threshold).
+constexpr double kLordFastWalkRmsMax_m = 2.5;
 
 std::filesystem::path temp_dir(const std::string& name) {
   const auto d = std::filesystem::temp_directory_path() / ("pednav_data_foot_ins_" + name);
@@ -157,13 +164,82 @@ PyshoeTrial run_pyshoe_trial(const std::string& trial, const std::string& detect
 }
 
 TEST(DataFootIns, PyshoeTrialMeanError) {
-  for (const auto& [trial, bound_m] : {std::pair<std::string, double>{"2018-02-09-11-19-39", kPyshoeMeanMax_m},
-                                       std::pair<std::string, double>{"2017-11-22-11-22-03", kPyshoeWalkMeanMax_m}}) {
+  for (const auto& [trial, bound_m] : {std::pair<std::string, double>{"2017-11-22-11-22-03", kPyshoeWalk1MeanMax_m},
+                                       std::pair<std::string, double>{"2017-11-22-11-30-14", kPyshoeWalk2MeanMax_m},
+                                       std::pair<std::string, double>{"2017-11-27-11-25-12", kPyshoeRunMeanMax_m},
+                                       std::pair<std::string, double>{"2018-02-09-11-19-39", kPyshoeMeanMax_m}}) {
     PEDNAV_REQUIRE_DATA(test::shared_data("foot_pyshoe_vicon/csv/" + trial + ".csv"));
     const PyshoeTrial r = run_pyshoe_trial(trial, "");
     EXPECT_LT(r.mean_m, bound_m) << trial;
     EXPECT_GT(r.epochs, 500) << trial;
   }
+}
+
+// LORD hallway experiment 35 with the committed configuration, scored at the measured footprints as scripts/foot_eval
+// does: reference = footprint k at the end of stance k (the stride time file), start-aligned; the solution epoch
+// nearest each footprint time (within 0.05 s) gives the error there.
+TEST(DataFootIns, LordFastWalkErrorAtTheFootprints) {
+  const std::string base = test::shared_data("foot_lord_gcp_hallway/SensorConnectData_35");
+  PEDNAV_REQUIRE_DATA(base + ".csv");
+  const auto out = temp_dir("lord_35");
+  std::vector<double> times;
+  {
+    std::ifstream st(base + "_strideIndex_timestamp_gcpX_gcpY.csv"), gcp(base + "_GCP.csv");
+    std::ofstream ref(out / "ref.csv");
+    ref << "gps_week,gps_tow_s,e_m,n_m,u_m\n";
+    std::string a, b;
+    std::getline(st, a);
+    std::getline(gcp, b);
+    while (std::getline(st, a) && std::getline(gcp, b)) {
+      std::stringstream sa(a), sb(b);
+      std::string idx, t, stride, x, y;
+      std::getline(sa, idx, ',');
+      std::getline(sa, t, ',');
+      std::getline(sb, stride, ',');
+      std::getline(sb, x, ',');
+      std::getline(sb, y, ',');
+      times.push_back(std::stod(t));
+      ref << "0," << t << ',' << x << ',' << y << ",0\n";
+    }
+  }
+  ASSERT_EQ(times.size(), 29u);
+  auto cfg = load_run_config(test::source_path("datasets/foot/lord_35.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  auto sum = run_run_command(*cfg, (out / "run").string());
+  ASSERT_TRUE(sum) << sum.error().message;
+  CompareArgs args;
+  args.solution = (out / "run" / "solution.csv").string();
+  args.reference = (out / "ref.csv").string();
+  args.out_dir = (out / "cmp").string();
+  args.compare.align = eval::Align::kStart;
+  auto ev = run_compare(args);
+  ASSERT_TRUE(ev) << ev.error().message;
+  std::vector<std::pair<double, double>> rows;  // (tow, horizontal error)
+  {
+    std::ifstream in(out / "cmp" / "errors.csv");
+    std::string line;
+    std::getline(in, line);  // gps_week,gps_tow_s,de_m,dn_m,du_m,horizontal_m
+    while (std::getline(in, line)) {
+      std::stringstream ss(line);
+      std::string c[6];
+      for (auto& x : c) std::getline(ss, x, ',');
+      rows.emplace_back(std::stod(c[1]), std::stod(c[5]));
+    }
+  }
+  double sum_sq = 0.0;
+  int n = 0;
+  for (const double t : times) {
+    const auto near = std::min_element(rows.begin(), rows.end(), [t](const auto& p, const auto& q) {
+      return std::abs(p.first - t) < std::abs(q.first - t);
+    });
+    if (near == rows.end() || std::abs(near->first - t) > 0.05) continue;
+    sum_sq += near->second * near->second;
+    ++n;
+  }
+  ASSERT_EQ(n, 29);
+  const double rms_m = std::sqrt(sum_sq / n);
+  std::printf("[lord 35] RMS at %d footprints %.3f m\n", n, rms_m);
+  EXPECT_LT(rms_m, kLordFastWalkRmsMax_m);
 }
 
 // zupt.detector labels with the pyshoe format's stance column: the stance is exactly PyShoe's stored labels (its
