@@ -1,7 +1,7 @@
 // INS/ZUPT (`mode: ins`) on real foot data with the committed configurations of datasets/foot/ (issue 5):
 // x-io short loop closure, the mean start-aligned horizontal error of the four PyShoe Vicon trials, and the error of
 // LORD #35 at its footprints. The bounds are the figures measured when the test was written (docs/results.md) plus a
-// margin, so a regression shows; only PyShoe trial 2's bound is the issue's target (the others are not met yet).
+// margin, so a regression shows; PyShoe trials 2 and 3 are bounded by the issue's targets (met), the others are not.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -29,21 +29,23 @@ constexpr double kXioShortClosureMax_m = 0.15;
 constexpr double kXioShortDistanceMin_m = 20.0;
 constexpr double kXioShortDistanceMax_m = 40.0;
 // PyShoe trials, same configuration (one for the GX5-25: PyShoe's process noise, SHOE γ 3, gait-adaptive α 3 next to
-// a swing, ZARU gate; docs/results.md "Session 21"), mean horizontal error after start alignment. Measured 0.063 /
-// 0.113 / 0.125 / 0.058 m (PyShoe tuned per trial: 0.045 / 0.132 / 0.112 / 0.047 m). Before session 21 (data-sheet
-// noise, γ 10, α 2, no swing condition): 0.091 / 0.613 / 2.781 / 0.114 m. Without the swing condition trial 4 is
-// 0.858 m, with the data-sheet noise trials 1-3 are 0.080 / 0.826 / 1.568 m, with α 2 trial 3 is 0.479 m, with γ 10
-// trial 4 is 0.106 m: each bound fails without the change it guards.
+// a swing, every stance sample, ZARU gate; docs/results.md "Session 21"), mean horizontal error after start alignment.
+// Measured 0.067 / 0.104 / 0.097 / 0.051 m (PyShoe tuned per trial: 0.045 / 0.132 / 0.112 / 0.047 m). Before session
+// 21: 0.091 / 0.613 / 2.781 / 0.114 m. Without the swing condition trial 4 is 0.851 m, with the data-sheet noise
+// 0.136 / 0.629 / 1.177 m on trials 1-3, with α 2 trial 3 is 0.471 m, with γ 10 trial 4 is 0.112 m, with the 0.02-s
+// stance-edge skip trial 3 is 0.125 m, without the ZARU gate trial 1 is 0.193 m: each bound fails without the change
+// it guards. Trials 2 and 3 are bounded by the issue's targets (PyShoe's figures), which they meet.
 constexpr double kPyshoeWalk1MeanMax_m = 0.075;
-constexpr double kPyshoeWalk2MeanMax_m = 0.132;  // PyShoe's own tuned figure: met
-constexpr double kPyshoeRunMeanMax_m = 0.16;
-constexpr double kPyshoeMeanMax_m = 0.08;
-// The 2018 trial with PyShoe's own stance labels (zupt.detector labels): measured 0.045 m (RMS 0.057, max 0.160 m),
-// i.e. PyShoe's 0.047 m with its stances; 0.145 m with the data-sheet process noise.
+constexpr double kPyshoeWalk2MeanMax_m = 0.132;
+constexpr double kPyshoeRunMeanMax_m = 0.112;
+constexpr double kPyshoeMeanMax_m = 0.07;
+// The 2018 trial with PyShoe's own stance labels (zupt.detector labels): measured 0.044 m (RMS 0.056 m), i.e.
+// PyShoe's 0.047 m with its stances; 0.145 m with the data-sheet process noise.
 constexpr double kPyshoeLabelsMeanMax_m = 0.06;
-// LORD #35 (fast walk, 29 footprints), same GX5-25 configuration: RMS error at the footprints measured 1.51 m, final
-// 2.7 % of the path; 31.6 m before session 21, 12.3 m with α 2, 18.0 m with the data-sheet noise.
-constexpr double kLordFastWalkRmsMax_m = 2.5;
+// LORD #35 (fast walk, 29 footprints), same GX5-25 configuration: RMS error at the footprints measured 1.25 m, final
+// 3.5 % of the path; 31.6 m before session 21, 12.3 m with α 2, 18.0 m with the data-sheet noise, 5.05 m without the
+// ZARU gate.
+constexpr double kLordFastWalkRmsMax_m = 2.0;
 
 std::filesystem::path temp_dir(const std::string& name) {
   const auto d = std::filesystem::temp_directory_path() / ("pednav_data_foot_ins_" + name);
