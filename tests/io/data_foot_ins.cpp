@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -54,6 +55,30 @@ std::filesystem::path temp_dir(const std::string& name) {
   return d;
 }
 
+// Runs `cfg` into out/run and compares its solution.csv with `reference` (start-aligned; the solution itself when
+// empty, as a loop) into out/cmp. Failures are test failures; nullopt then.
+struct RunAndCompare {
+  fusion::EngineSummary summary;
+  eval::Evaluation evaluation;
+};
+
+std::optional<RunAndCompare> run_and_compare(const RunConfig& cfg, const std::filesystem::path& out,
+                                             const std::string& reference) {
+  auto sum = run_run_command(cfg, (out / "run").string());
+  EXPECT_TRUE(sum) << sum.error().message;
+  if (!sum) return std::nullopt;
+  CompareArgs args;
+  args.solution = (out / "run" / "solution.csv").string();
+  args.reference = reference.empty() ? args.solution : reference;
+  args.out_dir = (out / "cmp").string();
+  args.compare.align = eval::Align::kStart;
+  args.compare.loop = reference.empty();
+  auto ev = run_compare(args);
+  EXPECT_TRUE(ev) << ev.error().message;
+  if (!ev) return std::nullopt;
+  return RunAndCompare{*sum, *ev};
+}
+
 // An x-io loop with the committed configuration (detector replaced unless empty): the solution against itself,
 // closure = first-to-last horizontal distance.
 struct XioLoop {
@@ -69,22 +94,14 @@ XioLoop run_xio_loop(const std::string& loop, const std::string& detector) {
   if (!cfg) return r;
   if (!detector.empty()) cfg->zupt.detector = detector;
   const auto out = temp_dir("xio_" + loop + "_" + (detector.empty() ? "configured" : detector));
-  auto sum = run_run_command(*cfg, (out / "run").string());
-  EXPECT_TRUE(sum) << sum.error().message;
-  if (!sum) return r;
-  r.zupt_updates = static_cast<long>(sum->zupt_updates);
-  r.covariance_healthy = sum->covariance_healthy;
-  CompareArgs args;
-  args.solution = args.reference = (out / "run" / "solution.csv").string();
-  args.out_dir = (out / "cmp").string();
-  args.compare.align = eval::Align::kStart;
-  args.compare.loop = true;
-  auto ev = run_compare(args);
-  EXPECT_TRUE(ev) << ev.error().message;
-  if (!ev) return r;
-  r.closure_m = ev->closure_m;
-  r.distance_m = ev->distance_m;
-  r.closure_pct = ev->closure_pct_of_distance;
+  const auto rc = run_and_compare(*cfg, out, "");
+  if (!rc) return r;
+  r.zupt_updates = static_cast<long>(rc->summary.zupt_updates);
+  r.covariance_healthy = rc->summary.covariance_healthy;
+  const eval::Evaluation& ev = rc->evaluation;
+  r.closure_m = ev.closure_m;
+  r.distance_m = ev.distance_m;
+  r.closure_pct = ev.closure_pct_of_distance;
   return r;
 }
 
@@ -144,22 +161,14 @@ PyshoeTrial run_pyshoe_trial(const std::string& trial, const std::string& detect
   EXPECT_TRUE(cfg) << cfg.error().message;
   if (!cfg) return r;
   if (!detector.empty()) cfg->zupt.detector = detector;
-  auto sum = run_run_command(*cfg, (out / "run").string());
-  EXPECT_TRUE(sum) << sum.error().message;
-  if (!sum) return r;
-  r.zupt_samples = static_cast<long>(sum->zupt_samples);
-  CompareArgs args;
-  args.solution = (out / "run" / "solution.csv").string();
-  args.reference = (out / "ref.csv").string();
-  args.out_dir = (out / "cmp").string();
-  args.compare.align = eval::Align::kStart;
-  auto ev = run_compare(args);
-  EXPECT_TRUE(ev) << ev.error().message;
-  if (!ev) return r;
-  r.mean_m = ev->horizontal_mean_m;
-  r.rms_m = ev->horizontal_rms_m;
-  r.max_m = ev->horizontal_max_m;
-  r.epochs = ev->epochs_compared;
+  const auto rc = run_and_compare(*cfg, out, (out / "ref.csv").string());
+  if (!rc) return r;
+  r.zupt_samples = static_cast<long>(rc->summary.zupt_samples);
+  const eval::Evaluation& ev = rc->evaluation;
+  r.mean_m = ev.horizontal_mean_m;
+  r.rms_m = ev.horizontal_rms_m;
+  r.max_m = ev.horizontal_max_m;
+  r.epochs = ev.epochs_compared;
   std::printf("[pyshoe %s %s] mean %.3f m, RMS %.3f m, max %.3f m over %d epochs; stance samples %ld (labelled %ld)\n",
               trial.c_str(), detector.empty() ? "configured" : detector.c_str(), r.mean_m, r.rms_m, r.max_m, r.epochs,
               r.zupt_samples, r.labelled_stance_samples);
@@ -208,15 +217,7 @@ TEST(DataFootIns, LordFastWalkErrorAtTheFootprints) {
   ASSERT_EQ(times.size(), 29u);
   auto cfg = load_run_config(test::source_path("datasets/foot/lord_35.yaml"));
   ASSERT_TRUE(cfg) << cfg.error().message;
-  auto sum = run_run_command(*cfg, (out / "run").string());
-  ASSERT_TRUE(sum) << sum.error().message;
-  CompareArgs args;
-  args.solution = (out / "run" / "solution.csv").string();
-  args.reference = (out / "ref.csv").string();
-  args.out_dir = (out / "cmp").string();
-  args.compare.align = eval::Align::kStart;
-  auto ev = run_compare(args);
-  ASSERT_TRUE(ev) << ev.error().message;
+  ASSERT_TRUE(run_and_compare(*cfg, out, (out / "ref.csv").string()));
   std::vector<std::pair<double, double>> rows;  // (tow, horizontal error)
   {
     std::ifstream in(out / "cmp" / "errors.csv");
