@@ -41,7 +41,7 @@ constexpr double kPyshoeWalk2MeanMax_m = 0.132;
 constexpr double kPyshoeRunMeanMax_m = 0.112;
 constexpr double kPyshoeMeanMax_m = 0.07;
 // The 2018 trial with PyShoe's own stance labels (zupt.detector labels): measured 0.044 m (RMS 0.056 m), i.e.
-// PyShoe's 0.047 m with its stances; 0.145 m with the data-sheet process noise.
+// PyShoe's 0.047 m with its stances; 0.126 m with the data-sheet process noise.
 constexpr double kPyshoeLabelsMeanMax_m = 0.06;
 // LORD #35 (fast walk, 29 footprints), same GX5-25 configuration: RMS error at the footprints measured 1.25 m, final
 // 3.5 % of the path; 31.6 m before session 21, 12.3 m with α 2, 18.0 m with the data-sheet noise, 5.05 m without the
