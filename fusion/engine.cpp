@@ -30,6 +30,8 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::Vector3d;
 using Eigen::VectorXd;
+/// Three measurement rows over the error state (fixed-capacity: no heap allocation in the update loop).
+using Rows3 = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3, ins::kMaxErrorDim>;
 
 // Plausibility bounds of the nominal state (health check): 6250..6500 km from the centre covers every point from
 // below the Dead Sea to 120 km altitude at any latitude; 100 m/s is far above any foot speed.
@@ -384,7 +386,7 @@ class Filter {
   static void reexpress_velocity_attitude(const Eigen::Matrix3d& A, ErrorMatrix& P_) {
     // J P J^T = P + E_v A P_φ· + P_·φ A^T E_v^T + E_v A P_φφ A^T E_v^T
     const int v = ins::kVel.offset, a = ins::kAtt.offset;
-    Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3, ins::kMaxErrorDim> APa;
+    Rows3 APa;
     APa.noalias() = A * P_.middleRows<3>(a);  // A P_φ· (3 x n), from the P before the update
     const Eigen::Matrix3d APaaAt = A * P_.block<3, 3>(a, a) * A.transpose();
     P_.middleRows<3>(v) += APa;
@@ -1090,7 +1092,7 @@ class Runner {
     const Vector3d v = f.x().nav.v_eb_e;
     bool zaru = o_.zaru && interval_start_stance && inc.dt_s > 0.0;
     Vector3d r_zaru = Vector3d::Zero();
-    Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3, ins::kMaxErrorDim> H_zaru;
+    Rows3 H_zaru;
     if (zaru) {
       H_zaru = zaru_rows(f, inc, r_zaru);
       if (zaru_gate_threshold_ > 0.0 && !zaru_passes_gate(f, H_zaru, r_zaru, zaru_variance(inc))) {
@@ -1128,10 +1130,8 @@ class Runner {
 
   // ZARU rows: the measured rate (corrected by the current bias estimate) should equal the Earth rate in b; residual
   // into `r`, Jacobian returned (3 x n).
-  Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3, ins::kMaxErrorDim> zaru_rows(
-      const Filter& f, const ins::ImuIncrement& inc, Vector3d& r) const {
-    Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3, ins::kMaxErrorDim> H =
-        Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3, ins::kMaxErrorDim>::Zero(3, f.layout().dim());
+  Rows3 zaru_rows(const Filter& f, const ins::ImuIncrement& inc, Vector3d& r) const {
+    Rows3 H = Rows3::Zero(3, f.layout().dim());
     const Vector3d omega_ie_b = f.x().nav.R_e_b().transpose() * Vector3d(0, 0, wgs84::kOmegaIE_radps);
     r = inc.alpha_b / inc.dt_s - omega_ie_b;  // = true - estimated bias if the foot is still
     H.block<3, 3>(0, ins::kBiasGyro.offset).setIdentity();
@@ -1149,9 +1149,7 @@ class Runner {
   }
 
   // ZARU innovation gate (docs/fusion.md §5.3): d² = rᵀ S⁻¹ r, S = H P Hᵀ + R, against χ²(3) at zaru_gate_probability.
-  bool zaru_passes_gate(const Filter& f, const Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3,
-                                                             ins::kMaxErrorDim>& H,
-                        const Vector3d& r, double variance) const {
+  bool zaru_passes_gate(const Filter& f, const Rows3& H, const Vector3d& r, double variance) const {
     Eigen::Matrix3d S = H * f.P() * H.transpose();
     S.diagonal().array() += variance;
     const Eigen::LDLT<Eigen::Matrix3d> ldlt(S);

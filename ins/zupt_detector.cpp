@@ -348,10 +348,11 @@ std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& s, const Z
     const int hw = o.shoe_adaptive_factor > 0 ? half_window(s, o.shoe_adaptive_window_s) : 0;
     // Only where the window also holds a swing (peak |ω| >= shoe_adaptive_min_peak_radps): slow motion without
     // swings keeps γ.
+    const bool swing_condition = hw > 0 && o.shoe_adaptive_min_peak_radps > 0;
     std::deque<int> mins;   // indices of increasing T over the sliding window (monotone queue)
-    std::deque<int> peaks;  // indices of decreasing |ω| over the same window
-    std::vector<double> rate(n);
-    for (int k = 0; k < n; ++k) rate[k] = s[k].omega_ib_b.norm();
+    std::deque<int> peaks;  // indices of decreasing |ω| over the same window (swing condition only)
+    std::vector<double> rate(swing_condition ? n : 0);
+    for (int k = 0; k < static_cast<int>(rate.size()); ++k) rate[k] = s[k].omega_ib_b.norm();
     int next = 0;
     for (int k = 0; k < n; ++k) {
       d[k].statistic = t[k];
@@ -360,13 +361,14 @@ std::vector<ZuptDecision> detect_stance(const std::vector<ImuSample>& s, const Z
         for (; next < n && next <= k + hw; ++next) {
           while (!mins.empty() && t[mins.back()] >= t[next]) mins.pop_back();
           mins.push_back(next);
+          if (!swing_condition) continue;
           while (!peaks.empty() && rate[peaks.back()] <= rate[next]) peaks.pop_back();
           peaks.push_back(next);
         }
         while (mins.front() < k - hw) mins.pop_front();
-        while (peaks.front() < k - hw) peaks.pop_front();
+        while (swing_condition && peaks.front() < k - hw) peaks.pop_front();
         const double m = t[mins.front()];
-        const bool swing_near = rate[peaks.front()] >= o.shoe_adaptive_min_peak_radps;
+        const bool swing_near = !swing_condition || rate[peaks.front()] >= o.shoe_adaptive_min_peak_radps;
         if (m < o.shoe_adaptive_max && swing_near) thr = std::max(thr, o.shoe_adaptive_factor * m);
       }
       d[k].stance = t[k] < thr;
