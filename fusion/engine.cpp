@@ -41,6 +41,9 @@ constexpr double kMaxSpeed_mps = 100.0;
 // ins mode: yaw σ kept inside the filter; the rest of the configured initial heading σ is a frame rotation carried
 // outside it (docs/fusion.md §5.5). Small but non-zero so that P stays positive definite from the first epoch.
 constexpr double kInsFilterSigmaYawRad = 0.1 * 3.14159265358979323846 / 180.0;
+// The first still period's mean rate is taken as the initial gyro bias when its d² (docs/ins.md eq. 6.1) is within
+// the χ²(3) quantile at this probability.
+constexpr double kStillGyroBiasGateProbability = 0.999;
 
 // Heading-frame uncertainty of an ins-mode run: variance of a rotation about up_e through origin_e [rad², m].
 struct FrameYaw {
@@ -1613,7 +1616,20 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
   auto level = ins::coarse_level(still, p0, 0.0, ins::StillnessOptions{1.0, 2.0, 2.0, 0.1});
   if (!level) return make_error("IMU levelling at " + samples[s0].t.to_string() + ": " + level.error().message);
   ins::ImuErrors imu0;
-  if (level->duration_s >= 2.0) imu0.b_g = level->gyro_bias_b;
+  // The still period's mean rate as the initial gyro bias — unless the window moved (docs/ins.md §6, eq. 6.1).
+  if (level->duration_s >= 2.0) {
+    const Vector3d b_deg_per_h = level->gyro_bias_b * kRadToDeg * 3600.0;
+    sum.still_gyro_bias_d2 = ins::still_gyro_bias_d2(*level, o.spec.gyro_bias_initial, o.spec.gyro_arw);
+    if (o.spec.gyro_bias_initial <= 0.0 ||
+        sum.still_gyro_bias_d2 <= gnss::chi_square_quantile(kStillGyroBiasGateProbability, 3)) {
+      imu0.b_g = level->gyro_bias_b;
+      sum.initial_gyro_bias_deg_per_h = b_deg_per_h;
+    } else {
+      how += fmt_message("; gyro bias not taken from the first still period (mean rate %.0f, %.0f, %.0f deg/h is %.1f "
+                         "turn-on sigmas: the IMU moved)",
+                         b_deg_per_h.x(), b_deg_per_h.y(), b_deg_per_h.z(), std::sqrt(sum.still_gyro_bias_d2));
+    }
+  }
 
   // Heading: configured, else from motion (INS/ZUPT track with yaw 0 fitted to the GNSS epoch solutions).
   double yaw0 = 0.0;

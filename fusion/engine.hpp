@@ -192,6 +192,10 @@ struct EngineSummary {
   std::optional<GpsTime> heading_init_end;  ///< end of the heading-from-motion span (tc without a configured yaw)
   double heading_init_distance_m = 0.0;     ///< distance the INS/ZUPT track walked for it [m] (docs/fusion.md §8)
   double initial_yaw_deg = 0.0;
+  /// Gyro bias the filter started from [deg/h] (body axes): the first still period's mean rate minus Earth rate when
+  /// that window is >= 2 s and consistent with the turn-on bias (docs/ins.md eq. 6.1), else zero.
+  Eigen::Vector3d initial_gyro_bias_deg_per_h = Eigen::Vector3d::Zero();
+  double still_gyro_bias_d2 = 0.0;   ///< eq. 6.1 of the first still period (0 when shorter than 2 s)
   bool covariance_healthy = true;    ///< false once a health check failed (even if re-initialized afterwards)
   std::string health_message;
   // Accounting and recovery (docs/robustness.md): every IMU sample and rover measurement is used, rejected or skipped,

@@ -78,6 +78,11 @@ Expected<Levelling> coarse_level(const std::vector<ImuSample>& samples, const Ei
   return lv;
 }
 
+double still_gyro_bias_d2(const Levelling& lv, double gyro_bias_initial_radps, double gyro_arw) {
+  const double var_mean = lv.duration_s > 0.0 ? gyro_arw * gyro_arw / lv.duration_s : 0.0;
+  return lv.gyro_bias_b.squaredNorm() / (gyro_bias_initial_radps * gyro_bias_initial_radps + var_mean);
+}
+
 int initial_still_samples(const std::vector<ImuSample>& samples, const StillnessOptions& o) {
   // Grow the window sample by sample with running sums; stop at the first sample that breaks the thresholds.
   const int n = static_cast<int>(samples.size());

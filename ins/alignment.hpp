@@ -42,6 +42,12 @@ Expected<Levelling> coarse_level(const std::vector<ImuSample>& samples, const Ei
 /// 0 if the log does not start still.
 int initial_still_samples(const std::vector<ImuSample>& samples, const StillnessOptions& options = {});
 
+/// Normalized distance of a still window's gyro-bias estimate (lv.gyro_bias_b) from the turn-on prior N(0, σ_b0² I):
+/// d² = |b|² / (σ_b0² + ARW² / T), T = lv.duration_s (docs/ins.md §6, eq. 6.1). A detected stance is not always static
+/// (a foot that rolls at 1 deg/s before its first step); a d² beyond a χ²(3) quantile says the window moved and its
+/// mean rate is not the bias. gyro_bias_initial_radps [rad/s] > 0, gyro_arw [rad/sqrt(s)] >= 0.
+double still_gyro_bias_d2(const Levelling& lv, double gyro_bias_initial_radps, double gyro_arw);
+
 /// A navigation state at rest at p_eb_e [m] (ECEF), time t (GPST), with attitude from roll, pitch, yaw [rad]
 /// (R_e_b = R_e_n(lat, lon) R_n_b(roll, pitch, yaw)).
 NavState nav_state_at_rest(GpsTime t, const Eigen::Vector3d& p_eb_e, double roll, double pitch, double yaw);

@@ -269,6 +269,9 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
   j["mode"] = c.mode;
   j["initialization"] = sum.initialization;
   j["initial_yaw_deg"] = sum.initial_yaw_deg;
+  j["initial_gyro_bias_deg_per_h"] = {sum.initial_gyro_bias_deg_per_h.x(), sum.initial_gyro_bias_deg_per_h.y(),
+                                      sum.initial_gyro_bias_deg_per_h.z()};
+  j["still_gyro_bias_d2"] = sum.still_gyro_bias_d2;
   j["heading_fit_rms_m"] = sum.heading_fit_rms_m;
   if (sum.heading_init_end) {
     j["heading_init_distance_m"] = sum.heading_init_distance_m;

@@ -66,6 +66,29 @@ TEST(Alignment, MovingOrWrongUnitsAreRejectedWithReason) {
   EXPECT_THAT(bad.error().message, HasSubstr("is not local gravity"));
 }
 
+// Eq. 6.1 of docs/ins.md: d² of a still window's bias estimate against the turn-on prior; a window that rolls at
+// 1 deg/s for its last second is far outside a 0.04 deg/s prior, a static one with a 1-sigma bias is not.
+TEST(Alignment, StillWindowGyroBiasIsCheckedAgainstTheTurnOnPrior) {
+  Levelling lv;
+  lv.duration_s = 4.0;
+  lv.gyro_bias_b = Eigen::Vector3d(3e-4, -4e-4, 0.0);                // |b| = 5e-4 rad/s
+  EXPECT_NEAR(still_gyro_bias_d2(lv, 5e-4, 0.0), 1.0, 1e-12);         // |b|² / σ_b0²
+  EXPECT_NEAR(still_gyro_bias_d2(lv, 5e-4, 1e-3), 0.5, 1e-12);        // + ARW²/T = 2.5e-7 rad²/s²
+  const NavState truth = test::nav_state_from_ll(GpsTime(), 45.0, 7.0, 0.0, 0.0, 0.0, 0.0);
+  auto log = still_log(truth, Eigen::Vector3d(1e-4, 0.0, -2e-4), 300, 9);  // 3 s at 100 Hz, noise 0.005 rad/s
+  auto still = coarse_level(log, truth.p_eb_e);
+  ASSERT_TRUE(still) << still.error().message;
+  constexpr double kGyroBiasInitial_radps = 0.04 * kDegToRad;  // gx5_25 turn-on σ (7e-4 rad/s)
+  constexpr double kNoiseArw = 0.005 * 0.1;                    // 0.005 rad/s per 10-ms sample as a density
+  const double d2_still = still_gyro_bias_d2(*still, kGyroBiasInitial_radps, kNoiseArw);
+  for (size_t i = 200; i < log.size(); ++i) log[i].omega_ib_b.z() += 1.0 * kDegToRad;  // rolls during its last second
+  auto rolling = coarse_level(log, truth.p_eb_e);
+  ASSERT_TRUE(rolling) << rolling.error().message;  // passes the stillness check: 1 deg/s is below its noise bound
+  const double d2_rolling = still_gyro_bias_d2(*rolling, kGyroBiasInitial_radps, kNoiseArw);
+  EXPECT_LT(d2_still, 16.27);   // χ²(3) at 0.999
+  EXPECT_GT(d2_rolling, 16.27);
+}
+
 TEST(Alignment, MagnetometerHeading) {
   constexpr double kTol_rad = 1e-9;
   // Field pointing north and down (inclination 60 deg); body yawed by 0.7 rad, rolled and pitched.
