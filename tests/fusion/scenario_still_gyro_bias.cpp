@@ -11,46 +11,27 @@
 #include <cstdio>
 #include <vector>
 
-#include "core/geodesy.hpp"
-#include "fusion/engine.hpp"
-#include "ins/imu_spec.hpp"
+#include "tests/fusion/labelled_level_imu.hpp"
 
 namespace pednav {
 namespace {
 
-constexpr double kRateHz = 200.0;
-constexpr double kGravityMps2 = 9.80665;
 constexpr double kTrueBiasZ_radps = 3e-4;             // 62 deg/h: 0.43 of the GX5-25 turn-on sigma
 constexpr double kRollRate_radps = 1.0 * kDegToRad;  // during the first stance's last second (rolling case)
 constexpr double kBiasTol_radps = 1e-6;               // noise-free log with the Earth rate
 
 fusion::EngineResult run(bool rolling) {
-  std::vector<ins::ImuSample> imu;
-  const GpsTime t0 = GpsTime::from_week_tow(2300, 100000.0);
-  const int n = static_cast<int>(6.1 * kRateHz);
-  const double lat = 43.78 * kDegToRad;
-  const Eigen::Vector3d earth_rate_b(wgs84::kOmegaIE_radps * std::cos(lat), 0.0, -wgs84::kOmegaIE_radps * std::sin(lat));
-  for (int i = 0; i < n; ++i) {
-    ins::ImuSample s;
-    s.t = t0.plus_ns(static_cast<int64_t>(i) * 5'000'000);
-    s.f_ib_b = Eigen::Vector3d(0.0, 0.0, -kGravityMps2);  // FRD body = NED, level, yaw 0
-    const bool roll_now = rolling && i >= static_cast<int>(2.0 * kRateHz) && i < static_cast<int>(3.0 * kRateHz);
-    s.omega_ib_b = earth_rate_b + Eigen::Vector3d(0.0, 0.0, kTrueBiasZ_radps + (roll_now ? kRollRate_radps : 0.0));
-    imu.push_back(s);
-  }
-  std::vector<uint8_t> labels(imu.size(), 1);
-  for (int i = static_cast<int>(3.0 * kRateHz); i < static_cast<int>(3.1 * kRateHz); ++i) labels[i] = 0;
-  fusion::EngineInputs in;
-  in.imu = &imu;
-  in.stance_labels = &labels;
-  fusion::EngineOptions o;
-  o.mode = fusion::Mode::kInsOnly;
-  o.spec = *ins::imu_spec_preset("gx5_25");
-  o.initial_position_e = ecef_from_geodetic(Geodetic{lat, -79.47 * kDegToRad, 190.0});
-  o.initial_yaw_rad = 0.0;
-  o.zupt.detector = "labels";
+  test::LabelledLevelImu log;
+  log.duration_s = 6.1;
+  log.no_stance_from_s = 3.0;
+  log.no_stance_to_s = 3.1;
+  log.earth_rate = true;
+  log.rate_b = [rolling](double t) {
+    return Eigen::Vector3d(0.0, 0.0, kTrueBiasZ_radps + (rolling && t >= 2.0 && t < 3.0 ? kRollRate_radps : 0.0));
+  };
+  fusion::EngineOptions o = test::labelled_level_imu_options();
   o.zaru = false;
-  auto r = fusion::run_forward(in, o);
+  auto r = test::run_labelled_level_imu(log, o);
   EXPECT_TRUE(r) << r.error().message;
   return r ? *r : fusion::EngineResult{};
 }

@@ -9,15 +9,11 @@
 #include <cstdio>
 #include <vector>
 
-#include "core/geodesy.hpp"
-#include "fusion/engine.hpp"
-#include "ins/imu_spec.hpp"
+#include "tests/fusion/labelled_level_imu.hpp"
 
 namespace pednav {
 namespace {
 
-constexpr double kRateHz = 200.0;
-constexpr double kGravityMps2 = 9.80665;
 constexpr double kTurnRadps = 0.3;
 // True bias 0: with the gate the estimate stays within the prior's noise; without it it ends near the turn rate.
 constexpr double kGatedBiasMax_radps = 0.005;
@@ -29,29 +25,11 @@ struct GateRun {
 };
 
 GateRun run(double gate_probability) {
-  std::vector<ins::ImuSample> imu;
-  const GpsTime t0 = GpsTime::from_week_tow(2300, 100000.0);
-  for (int i = 0; i < static_cast<int>(6.0 * kRateHz); ++i) {
-    ins::ImuSample s;
-    s.t = t0.plus_ns(static_cast<int64_t>(i) * 5'000'000);
-    s.f_ib_b = Eigen::Vector3d(0.0, 0.0, -kGravityMps2);  // FRD body, level
-    s.omega_ib_b = Eigen::Vector3d(0.0, 0.0, i >= 3.0 * kRateHz ? kTurnRadps : 0.0);
-    imu.push_back(s);
-  }
-  // Every sample is stance except 0.1 s at 2.5 s: the levelling window (the first stance run) ends there.
-  std::vector<uint8_t> labels(imu.size(), 1);
-  for (int i = static_cast<int>(2.5 * kRateHz); i < static_cast<int>(2.6 * kRateHz); ++i) labels[i] = 0;
-  fusion::EngineInputs in;
-  in.imu = &imu;
-  in.stance_labels = &labels;
-  fusion::EngineOptions o;
-  o.mode = fusion::Mode::kInsOnly;
-  o.spec = *ins::imu_spec_preset("gx5_25");
-  o.initial_position_e = ecef_from_geodetic(Geodetic{43.78 * kDegToRad, -79.47 * kDegToRad, 190.0});
-  o.initial_yaw_rad = 0.0;
-  o.zupt.detector = "labels";
+  test::LabelledLevelImu log;  // every sample stance except 0.1 s at 2.5 s: the levelling window ends there
+  log.rate_b = [](double t) { return Eigen::Vector3d(0.0, 0.0, t >= 3.0 ? kTurnRadps : 0.0); };
+  fusion::EngineOptions o = test::labelled_level_imu_options();
   o.zaru_gate_probability = gate_probability;
-  auto r = fusion::run_forward(in, o);
+  auto r = test::run_labelled_level_imu(log, o);
   EXPECT_TRUE(r) << r.error().message;
   GateRun g;
   if (!r) return g;
