@@ -1619,9 +1619,10 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
   // The still period's mean rate as the initial gyro bias — unless the window moved (docs/ins.md §6, eq. 6.1).
   if (level->duration_s >= 2.0) {
     const Vector3d b_deg_per_h = level->gyro_bias_b * kRadToDeg * 3600.0;
-    sum.still_gyro_bias_d2 = ins::still_gyro_bias_d2(*level, o.spec.gyro_bias_initial, o.spec.gyro_arw);
-    if (o.spec.gyro_bias_initial <= 0.0 ||
-        sum.still_gyro_bias_d2 <= gnss::chi_square_quantile(kStillGyroBiasGateProbability, 3)) {
+    // A spec without a turn-on σ has no prior to check against: the window's mean is taken (d² stays 0).
+    if (o.spec.gyro_bias_initial > 0.0)
+      sum.still_gyro_bias_d2 = ins::still_gyro_bias_d2(*level, o.spec.gyro_bias_initial, o.spec.gyro_arw);
+    if (sum.still_gyro_bias_d2 <= gnss::chi_square_quantile(kStillGyroBiasGateProbability, 3)) {
       imu0.b_g = level->gyro_bias_b;
       sum.initial_gyro_bias_deg_per_h = b_deg_per_h;
     } else {

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <optional>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -139,6 +140,7 @@ struct PyshoeTrial {
   double mean_m = 1e9, rms_m = 1e9, max_m = 1e9;
   int epochs = 0;
   long zupt_samples = 0, labelled_stance_samples = 0;
+  double still_gyro_bias_d2 = -1.0, initial_gyro_bias_deg_per_h = -1.0;  // summary.json (norm of the vector)
 };
 
 PyshoeTrial run_pyshoe_trial(const std::string& trial, const std::string& detector) {
@@ -168,6 +170,16 @@ PyshoeTrial run_pyshoe_trial(const std::string& trial, const std::string& detect
   const auto rc = run_and_compare(*cfg, out, (out / "ref.csv").string());
   if (!rc) return r;
   r.zupt_samples = static_cast<long>(rc->summary.zupt_samples);
+  {
+    std::ifstream js(out / "run" / "summary.json");
+    const auto j = nlohmann::json::parse(js, nullptr, false);
+    EXPECT_FALSE(j.is_discarded()) << trial;
+    if (!j.is_discarded()) {
+      r.still_gyro_bias_d2 = j.value("still_gyro_bias_d2", -1.0);
+      const auto b = j.value("initial_gyro_bias_deg_per_h", std::vector<double>{});
+      if (b.size() == 3) r.initial_gyro_bias_deg_per_h = std::hypot(b[0], b[1], b[2]);
+    }
+  }
   const eval::Evaluation& ev = rc->evaluation;
   r.mean_m = ev.horizontal_mean_m;
   r.rms_m = ev.horizontal_rms_m;
@@ -188,6 +200,14 @@ TEST(DataFootIns, PyshoeTrialMeanError) {
     const PyshoeTrial r = run_pyshoe_trial(trial, "");
     EXPECT_LT(r.mean_m, bound_m) << trial;
     EXPECT_GT(r.epochs, 500) << trial;
+    if (trial == "2017-11-22-11-22-03") {  // the foot rolls before its first step: the window's mean is not the bias
+      EXPECT_GT(r.still_gyro_bias_d2, 16.27);
+      EXPECT_EQ(r.initial_gyro_bias_deg_per_h, 0.0);
+    }
+    if (trial == "2018-02-09-11-19-39") {  // 12.6 s still: taken (measured d² 0.3, 82 deg/h)
+      EXPECT_LT(r.still_gyro_bias_d2, 16.27);
+      EXPECT_GT(r.initial_gyro_bias_deg_per_h, 0.0);
+    }
   }
 }
 
