@@ -74,6 +74,14 @@ struct PendingFix {
 // GNSS update rows held in fixed-capacity matrices (32 satellites with code + Doppler); more use dynamic ones.
 constexpr int kMaxGnssRows = 64;
 
+// Persistent-fault test (docs/fusion.md §6.2): one satellite's code w of its last consecutive GNSS epochs.
+struct FaultHistory {
+  gnss::SatId sat;
+  long epoch = -1;  // the engine's GNSS epoch count at the newest entry
+  int count = 0;    // valid entries in w (newest first)
+  std::array<double, kMaxFaultWindowEpochs - 1> w{};
+};
+
 int system_slot(const std::vector<gnss::System>& systems, gnss::System s) {
   for (size_t i = 0; i < systems.size(); ++i) {
     if (systems[i] == s) return static_cast<int>(i);
@@ -773,6 +781,8 @@ class Runner {
         m->try_emplace("used", 0);
         m->try_emplace("innovation_fault", 0);
       }
+      sum.code_used_rejected.try_emplace("persistent_fault", 0);
+      fault_history_.reserve(static_cast<size_t>(kMaxGnssRows));
     }
     // Smoother (docs/fusion.md §12): one backward record per output epoch, carried forward from each output epoch
     // to the next by the filter (eqs. 12.14-12.20).
@@ -948,6 +958,7 @@ class Runner {
         integrator = ins::IncrementIntegrator(io);  // the increments restart at this sample
         clock_initialized = false;
         implausible_streak_ = 0;
+        fault_history_.clear();  // innovations of the diverged filter are no evidence about the satellites
         prev_zupt = false;
         last_used = last_rejected = 0;
         stride_.reset();
@@ -1129,6 +1140,60 @@ class Runner {
       // the velocity-yaw correlation left by the swing makes the following stance ZUPTs act like form F.
       f.reexpress_velocity_attitude(skew(v_before - f.x().nav.v_eb_e));
     }
+  }
+
+  // Persistent-fault statistic of a code row with w-statistic `w` (docs/fusion.md eq. 6.5): the largest
+  // (Σ w)² / n over the windows of n = 2..N consecutive epochs that end with this one, the earlier terms from the
+  // satellite's history (each clipped to the single-epoch threshold k, so a blunder the single test already caught
+  // cannot carry the next epochs). Only when |w| ≥ 1 and the window sum has the sign of w: the fault must show in this
+  // epoch too. 0 when the test is off or the satellite has no history from the previous epoch.
+  double persistent_fault_statistic(const gnss::SatId& sat, double w) const {
+    if (o_.fault_window_epochs < 2 || std::abs(w) < 1.0) return 0.0;
+    const auto it = std::find_if(fault_history_.begin(), fault_history_.end(),
+                                 [&](const FaultHistory& e) { return e.sat == sat; });
+    if (it == fault_history_.end() || it->epoch != gnss_epoch_ - 1) return 0.0;
+    const FaultHistory& h = *it;
+    const double k = std::sqrt(w_test_threshold_);
+    double sum_w = w, best = 0.0;
+    for (int j = 0; j < h.count && j + 2 <= o_.fault_window_epochs; ++j) {
+      sum_w += std::clamp(h.w[static_cast<size_t>(j)], -k, k);
+      if (sum_w * w > 0.0) best = std::max(best, sum_w * sum_w / (j + 2));
+    }
+    return best;
+  }
+
+  // After the epoch's update: each code row's w in the last test it took part in becomes the newest history entry of
+  // its satellite (a satellite missing from an epoch starts over).
+  void record_fault_history(const std::vector<Row>& rows) {
+    if (o_.fault_window_epochs >= 2) {
+      for (size_t i = 0; i < rows.size(); ++i) {
+        if (rows[i].doppler) continue;
+        FaultHistory& h = fault_history_slot(rows[i].sat);
+        if (h.epoch != gnss_epoch_ - 1) h.count = 0;
+        const int keep = std::min(h.count, o_.fault_window_epochs - 2);
+        for (int j = keep; j > 0; --j) h.w[static_cast<size_t>(j)] = h.w[static_cast<size_t>(j - 1)];
+        h.w[0] = w_last_[i];
+        h.count = keep + 1;
+        h.epoch = gnss_epoch_;
+      }
+    }
+    ++gnss_epoch_;
+  }
+
+  // The history entry of `sat`: its own, else a new one, else the one not updated for longest (a set satellite).
+  FaultHistory& fault_history_slot(const gnss::SatId& sat) {
+    auto it = std::find_if(fault_history_.begin(), fault_history_.end(), [&](const FaultHistory& e) { return e.sat == sat; });
+    if (it != fault_history_.end()) return *it;
+    if (fault_history_.size() < static_cast<size_t>(kMaxGnssRows)) {
+      fault_history_.push_back(FaultHistory{});
+      it = fault_history_.end() - 1;
+    } else {
+      it = std::min_element(fault_history_.begin(), fault_history_.end(),
+                            [](const FaultHistory& a, const FaultHistory& b) { return a.epoch < b.epoch; });
+      *it = FaultHistory{};
+    }
+    it->sat = sat;
+    return *it;
   }
 
   // ZARU rows: the measured rate (corrected by the current bias estimate) should equal the Earth rate in b; residual
@@ -1369,6 +1434,7 @@ class Runner {
     std::vector<int>& active = active_;
     active.resize(rows.size());
     for (size_t i = 0; i < rows.size(); ++i) active[i] = static_cast<int>(i);
+    w_last_.assign(rows.size(), 0.0);
     int rejected_code = 0;
     // Up to kMaxGnssRows rows in fixed-capacity matrices (no heap allocation), more in dynamic ones.
     auto build = [&](auto& H, auto& r, auto& R) {
@@ -1421,12 +1487,24 @@ class Runner {
       first_test = false;
       int worst = -1;
       double worst_w2 = threshold;
+      bool worst_persistent = false;
       for (int i = 0; i < a.size(); ++i) {
-        const double w2 = a(i) * a(i) / Sinv(i, i);
-        if (records) (*records)[first_record + static_cast<size_t>(active[i])].w_final = a(i) / std::sqrt(Sinv(i, i));
+        const double w = a(i) / std::sqrt(Sinv(i, i));
+        w_last_[static_cast<size_t>(active[i])] = w;
+        if (records) (*records)[first_record + static_cast<size_t>(active[i])].w_final = w;
+        const double w2 = w * w;
         if (w2 > worst_w2) {
           worst_w2 = w2;
           worst = i;
+          worst_persistent = false;
+        }
+        if (const Row& row = rows[active[i]]; !row.doppler) {
+          const double g2 = persistent_fault_statistic(row.sat, w);
+          if (g2 > worst_w2) {
+            worst_w2 = g2;
+            worst = i;
+            worst_persistent = true;
+          }
         }
       }
       if (worst < 0 || active.size() <= 1) break;
@@ -1435,7 +1513,7 @@ class Runner {
       if (bad.doppler) {
         count(sum.doppler_used_rejected, "innovation_fault");
       } else {
-        count(sum.code_used_rejected, "innovation_fault");
+        count(sum.code_used_rejected, worst_persistent ? "persistent_fault" : "innovation_fault");
         ++rejected_code;
       }
       active.erase(active.begin() + worst);
@@ -1455,6 +1533,7 @@ class Runner {
       updated = f.update(r, H, R);
     }
     if (updated) ++sum.gnss_epochs_used;
+    record_fault_history(rows);
     // Divergence watch: most code rows of a well-observed epoch rejected, epoch after epoch (kImplausibleEpochs).
     const int code_rows = static_cast<int>(std::count_if(rows.begin(), rows.end(), [](const Row& w) { return !w.doppler; }));
     if (code_rows >= kImplausibleMinCodeRows && 2 * rejected_code > code_rows) ++implausible_streak_;
@@ -1489,6 +1568,10 @@ class Runner {
   std::vector<std::vector<double>> code_res_by_slot_;
   std::vector<double> doppler_res_;
   std::vector<int> active_;
+  std::vector<double> w_last_;  // per row of the epoch: w in the last test it took part in
+  // Persistent-fault test (docs/fusion.md §6.2): per satellite, the code w of the last consecutive GNSS epochs.
+  std::vector<FaultHistory> fault_history_;  // at most kMaxGnssRows satellites, reserved once (no allocation per epoch)
+  long gnss_epoch_ = 0;  // GNSS epochs that reached the w-test
 };
 
 // 2D rigid fit (rotation about the vertical + translation) of src onto dst (ENU); returns the rotation angle
@@ -1541,6 +1624,8 @@ std::vector<std::string> EngineOptions::problems() const {
   if (!(output_rate_hz > 0)) p.push_back("output.rate_hz must be > 0");
   if (!(zupt_sigma_mps > 0)) p.push_back("zupt.sigma_mps must be > 0");
   if (!(fault_probability > 0.5 && fault_probability < 1.0)) p.push_back("fault_rejection.probability must be in (0.5, 1)");
+  if (fault_window_epochs < 0 || fault_window_epochs > kMaxFaultWindowEpochs)
+    p.push_back("fault_rejection.window_epochs must be in [0, " + std::to_string(kMaxFaultWindowEpochs) + "]");
   if (!(zaru_gate_probability == 0.0 || (zaru_gate_probability > 0.5 && zaru_gate_probability < 1.0)))
     p.push_back("zupt.zaru_gate_probability must be 0 (no gate) or in (0.5, 1)");
   for (const auto& s : spec.problems()) p.push_back("imu.spec: " + s);

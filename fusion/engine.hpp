@@ -23,6 +23,9 @@
 
 namespace pednav::fusion {
 
+/// Longest window of the persistent-fault test (EngineOptions::fault_window_epochs) [epochs].
+inline constexpr int kMaxFaultWindowEpochs = 16;
+
 enum class Mode { kTightlyCoupled, kInsOnly };
 enum class ZuptForm { kDynamic /* D, seed 001 eq. 8 */, kFull /* F, seed 001 eq. 9 */ };
 
@@ -118,6 +121,9 @@ struct EngineOptions {
   double drift_psd_m2_per_s3 = 0.1;           ///< differential drift random walk PSD [m^2/s^3]
   double clock_jump_threshold_m = 300.0;      ///< median innovation above this resets the clock (ms jumps)
   double fault_probability = 0.999;           ///< chi-square(1) probability of the w-test
+  /// Persistent-fault test (docs/fusion.md §6.2): code rows are also tested over windows of up to this many
+  /// consecutive epochs of their satellite (0 or 1: off; at most kMaxFaultWindowEpochs).
+  int fault_window_epochs = 0;
   double max_base_age_s = 30.0;
   std::optional<Eigen::Vector3d> base_position_e;  ///< SD when set and base epochs are given
   // Output.

@@ -146,7 +146,8 @@ std::string to_yaml(const RunConfig& c) {
     << c.zupt.detector << YAML::Key << "form" << YAML::Value << c.zupt.form << YAML::Key << "edge_s" << YAML::Value
     << c.zupt.edge_s << YAML::EndMap;
   e << YAML::Key << "fault_rejection" << YAML::Value << YAML::BeginMap << YAML::Key << "probability"
-    << YAML::Value << c.fault_rejection_probability << YAML::EndMap;
+    << YAML::Value << c.fault_rejection_probability << YAML::Key << "window_epochs" << YAML::Value
+    << c.fault_rejection_window_epochs << YAML::EndMap;
   e << YAML::Key << "smoother" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled" << YAML::Value
     << c.smoother_enabled << YAML::EndMap;
   e << YAML::Key << "multipath" << YAML::Value << YAML::BeginMap << YAML::Key << "states" << YAML::Value

@@ -185,6 +185,7 @@ struct RunConfig {
   AntennaConfig antenna;
   ClockConfig clock;
   double fault_rejection_probability = 0.999;  ///< chi-square test probability of the innovation check
+  int fault_rejection_window_epochs = 0;       ///< persistent-fault test window [epochs] (0 or 1: off)
   bool smoother_enabled = true;
   OutputConfig output;
   MultipathConfig multipath;

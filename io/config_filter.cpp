@@ -1,5 +1,6 @@
 // YAML section reader: filter options (mechanization rate, ZUPT, fault rejection, smoother).
 #include "core/geodesy.hpp"
+#include "fusion/engine.hpp"
 #include "io/config.hpp"
 #include "io/yaml_schema.hpp"
 
@@ -89,6 +90,7 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
   {
     YamlMap f = top.map("fault_rejection");
     f.number("probability", out.fault_rejection_probability, false, 0.5, 1.0 - 1e-12);
+    f.integer("window_epochs", out.fault_rejection_window_epochs, false, 0, fusion::kMaxFaultWindowEpochs);
   }
   {
     YamlMap s = top.map("smoother");

@@ -137,6 +137,7 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.drift_psd_m2_per_s3 = c.clock.drift_psd_m2_per_s3;
   o.clock_jump_threshold_m = c.clock.jump_threshold_m;
   o.fault_probability = c.fault_rejection_probability;
+  o.fault_window_epochs = c.fault_rejection_window_epochs;
   o.output_rate_hz = c.output.rate_hz;
   o.smoother_enabled = c.smoother_enabled;
   o.multipath_sigma_m = c.multipath.states ? c.multipath.sigma_m : 0.0;

@@ -159,6 +159,22 @@ TEST(RunConfigBadInput, ZaruGateProbabilityOutsideItsRange) {
   EXPECT_THAT(o.problems().back(), HasSubstr("zupt.zaru_gate_probability must be 0 (no gate) or in (0.5, 1)"));
 }
 
+TEST(RunConfigBadInput, FaultWindowIsAWholeNumberOfEpochsWithinItsRange) {
+  const std::string head = "mode: ins\nimu:\n  file: imu.csv\n  format: pyshoe\nfault_rejection:\n";
+  auto ok = io::parse_run_config(head + "  window_epochs: 4\n", "run.yaml", "/data");
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_EQ(ok->fault_rejection_window_epochs, 4);
+  for (const char* bad : {"17", "-1", "2.5"}) {
+    auto c = io::parse_run_config(head + "  window_epochs: " + bad + "\n", "run.yaml", "/data");
+    ASSERT_FALSE(c) << bad;
+    EXPECT_THAT(c.error().message, HasSubstr("fault_rejection.window_epochs")) << bad;
+  }
+  fusion::EngineOptions o;
+  o.fault_window_epochs = fusion::kMaxFaultWindowEpochs + 1;
+  ASSERT_FALSE(o.problems().empty());
+  EXPECT_THAT(o.problems().back(), HasSubstr("fault_rejection.window_epochs must be in [0, 16]"));
+}
+
 TEST(RunConfigBadInput, ShoeAdaptivePeakRateIsDegreesPerSecondAndNotNegative) {
   const std::string head = "mode: ins\nimu:\n  file: imu.csv\n  format: pyshoe\nzupt:\n";
   auto ok = io::parse_run_config(head + "  shoe_adaptive_min_peak_rate_deg_per_s: 180\n", "run.yaml", "/data");
