@@ -82,6 +82,12 @@ struct FaultHistory {
   std::array<double, kMaxFaultWindowEpochs - 1> w{};
 };
 
+// The entry of `sat` in `histories` (const or not), or its end.
+template <typename Histories>
+auto find_fault_history(Histories& histories, const gnss::SatId& sat) {
+  return std::find_if(histories.begin(), histories.end(), [&](const FaultHistory& e) { return e.sat == sat; });
+}
+
 int system_slot(const std::vector<gnss::System>& systems, gnss::System s) {
   for (size_t i = 0; i < systems.size(); ++i) {
     if (systems[i] == s) return static_cast<int>(i);
@@ -1149,8 +1155,7 @@ class Runner {
   // epoch too. 0 when the test is off or the satellite has no history from the previous epoch.
   double persistent_fault_statistic(const gnss::SatId& sat, double w) const {
     if (o_.fault_window_epochs < 2 || std::abs(w) < 1.0) return 0.0;
-    const auto it = std::find_if(fault_history_.begin(), fault_history_.end(),
-                                 [&](const FaultHistory& e) { return e.sat == sat; });
+    const auto it = find_fault_history(fault_history_, sat);
     if (it == fault_history_.end() || it->epoch != gnss_epoch_ - 1) return 0.0;
     const FaultHistory& h = *it;
     const double k = std::sqrt(w_test_threshold_);
@@ -1181,8 +1186,9 @@ class Runner {
   }
 
   // The history entry of `sat`: its own, else a new one, else the one not updated for longest (a set satellite).
+
   FaultHistory& fault_history_slot(const gnss::SatId& sat) {
-    auto it = std::find_if(fault_history_.begin(), fault_history_.end(), [&](const FaultHistory& e) { return e.sat == sat; });
+    auto it = find_fault_history(fault_history_, sat);
     if (it != fault_history_.end()) return *it;
     if (fault_history_.size() < static_cast<size_t>(kMaxGnssRows)) {
       fault_history_.push_back(FaultHistory{});
