@@ -1186,7 +1186,6 @@ class Runner {
   }
 
   // The history entry of `sat`: its own, else a new one, else the one not updated for longest (a set satellite).
-
   FaultHistory& fault_history_slot(const gnss::SatId& sat) {
     auto it = find_fault_history(fault_history_, sat);
     if (it != fault_history_.end()) return *it;
