@@ -4,13 +4,13 @@
 #include <sstream>
 
 #include "apps/commands.hpp"
-#include "io/compare_command.hpp"
+#include "pipeline/compare_command.hpp"
 
 namespace pednav::apps {
 
 void add_compare_command(CLI::App& app, Action& action) {
   auto* cmd = app.add_subcommand("compare", "Errors of a solution against a reference trajectory");
-  auto args = std::make_shared<io::CompareArgs>();
+  auto args = std::make_shared<pipeline::CompareArgs>();
   auto sol_format = std::make_shared<std::string>("auto");
   auto ref_format = std::make_shared<std::string>("auto");
   auto align = std::make_shared<std::string>("none");
@@ -39,7 +39,7 @@ void add_compare_command(CLI::App& app, Action& action) {
                             : *align == "best-fit-2d" ? eval::Align::kBestFit2d
                             : *align == "best-fit-3d" ? eval::Align::kBestFit3d
                                                       : eval::Align::kNone;
-      auto ev = io::run_compare(*args);
+      auto ev = pipeline::run_compare(*args);
       if (!ev) {
         spdlog::error("{}", ev.error().message);
         return 1;

@@ -1,9 +1,9 @@
-// `pednav gnss CONFIG.yaml -o OUT`: thin registration; the work is io::run_gnss_command.
+// `pednav gnss CONFIG.yaml -o OUT`: thin registration; the work is pipeline::run_gnss_command.
 #include <spdlog/spdlog.h>
 
 #include "apps/commands.hpp"
 #include "io/config.hpp"
-#include "io/gnss_command.hpp"
+#include "pipeline/gnss_command.hpp"
 
 namespace pednav::apps {
 
@@ -20,7 +20,7 @@ void add_gnss_command(CLI::App& app, Action& action) {
         spdlog::error("{}", cfg.error().message);
         return 1;
       }
-      auto sum = io::run_gnss_command(*cfg, *out);
+      auto sum = pipeline::run_gnss_command(*cfg, *out);
       if (!sum) {
         spdlog::error("{}", sum.error().message);
         return 1;

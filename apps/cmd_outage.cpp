@@ -1,9 +1,9 @@
-// `pednav outage CONFIG.yaml -o OUT`: GNSS outage study (io/outage_command.hpp).
+// `pednav outage CONFIG.yaml -o OUT`: GNSS outage study (pipeline/outage_command.hpp).
 #include <spdlog/spdlog.h>
 
 #include "apps/commands.hpp"
 #include "io/config.hpp"
-#include "io/outage_command.hpp"
+#include "pipeline/outage_command.hpp"
 
 namespace pednav::apps {
 
@@ -11,7 +11,7 @@ void add_outage_command(CLI::App& app, Action& action) {
   auto* cmd = app.add_subcommand(
       "outage", "GNSS outage study: K windows of D s, full or partial (keep N satellites), forward and smoothed");
   auto config = std::make_shared<std::string>();
-  auto args = std::make_shared<io::OutageArgs>();
+  auto args = std::make_shared<pipeline::OutageArgs>();
   auto full = std::make_shared<bool>(false);
   auto keep = std::make_shared<int>(-1);
   auto keep_by = std::make_shared<std::string>("elevation");
@@ -54,7 +54,7 @@ void add_outage_command(CLI::App& app, Action& action) {
         return 1;
       }
       if (!mode->empty()) cfg->mode = *mode;
-      auto r = io::run_outage_command(*cfg, *args);
+      auto r = pipeline::run_outage_command(*cfg, *args);
       if (!r) {
         spdlog::error("{}", r.error().message);
         return 1;

@@ -3,7 +3,7 @@
 
 #include "apps/commands.hpp"
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 
 namespace pednav::apps {
 
@@ -23,7 +23,7 @@ void add_run_command(CLI::App& app, Action& action) {
         return 1;
       }
       if (!mode->empty()) cfg->mode = *mode;
-      auto sum = io::run_run_command(*cfg, *out);
+      auto sum = pipeline::run_run_command(*cfg, *out);
       if (!sum) {
         spdlog::error("{}", sum.error().message);
         return 1;

@@ -1,9 +1,9 @@
-// `pednav simulate SCENARIO.yaml -o OUT`: thin registration; the work is io::run_simulate_command.
+// `pednav simulate SCENARIO.yaml -o OUT`: thin registration; the work is pipeline::run_simulate_command.
 #include <spdlog/spdlog.h>
 
 #include "apps/commands.hpp"
 #include "io/scenario_config.hpp"
-#include "io/simulate_command.hpp"
+#include "pipeline/simulate_command.hpp"
 
 namespace pednav::apps {
 
@@ -22,7 +22,7 @@ void add_simulate_command(CLI::App& app, Action& action) {
         spdlog::error("{}", sc.error().message);
         return 1;
       }
-      auto sum = io::run_simulate_command(*sc, *out);
+      auto sum = pipeline::run_simulate_command(*sc, *out);
       if (!sum) {
         spdlog::error("{}", sum.error().message);
         return 1;

@@ -1,12 +1,12 @@
 // `pednav zupt CONFIG.yaml -o OUT` and `pednav hmm-train CONFIG.yaml... -o hmm.yaml`: thin registrations; the work
-// is io::run_zupt_command / io::run_hmm_train_command.
+// is pipeline::run_zupt_command / pipeline::run_hmm_train_command.
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
 
 #include "apps/commands.hpp"
 #include "io/config.hpp"
-#include "io/zupt_command.hpp"
+#include "pipeline/zupt_command.hpp"
 
 namespace pednav::apps {
 namespace {
@@ -41,7 +41,7 @@ void add_zupt_command(CLI::App& app, Action& action) {
         return 1;
       }
       if (!detector->empty()) cfg->zupt.detector = *detector;
-      auto sum = io::run_zupt_command(*cfg, *out);
+      auto sum = pipeline::run_zupt_command(*cfg, *out);
       if (!sum) {
         spdlog::error("{}", sum.error().message);
         return 1;
@@ -82,7 +82,7 @@ void add_hmm_train_command(CLI::App& app, Action& action) {
         }
         cfgs.push_back(std::move(*cfg));
       }
-      auto f = io::run_hmm_train_command(cfgs, *out, *iterations);
+      auto f = pipeline::run_hmm_train_command(cfgs, *out, *iterations);
       if (!f) {
         spdlog::error("{}", f.error().message);
         return 1;

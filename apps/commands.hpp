@@ -1,4 +1,4 @@
-// Each subcommand registers itself on the CLI11 app; its work is done by a function in io/ (testable).
+// Each subcommand registers itself on the CLI11 app; its work is done by a function in pipeline/ (testable).
 #pragma once
 
 #include <CLI/CLI.hpp>

@@ -1,6 +1,6 @@
 // Monte Carlo consistency of a navigation filter (seed 000, issue 9): per output epoch across M seeded runs the
 // mean error, the sample σ of the error, the mean filter σ (√P), the average NEES with its two-sided 95 % χ² band,
-// and the RMS error vs distance travelled. Pure aggregation: no I/O (apps/cmd_montecarlo.cpp reads and writes).
+// and the RMS error vs distance travelled. Pure aggregation: no I/O (pipeline/montecarlo_command.cpp reads and writes).
 // Definitions and how to read the figures: docs/consistency.md.
 #pragma once
 

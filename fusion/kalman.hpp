@@ -1,6 +1,6 @@
 // The EKF covariance prediction and Joseph-form update of the forward engine on fixed-capacity matrices
 // (ins::ErrorMatrix: sized at run time, stored inline): no heap allocation when the measurement matrices have a
-// fixed capacity too (docs/performance.md). Used by fusion/engine.cpp and the benchmarks in bench/.
+// fixed capacity too (docs/performance.md). Used by fusion/error_state_filter and the benchmarks in bench/.
 #pragma once
 
 #include <Eigen/Cholesky>

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 #include "io/scenario_config.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -21,7 +21,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     const std::string again = pednav::io::to_yaml(*cfg);
     (void)pednav::io::parse_run_config(again, "resolved.yaml", "/nonexistent");
-    (void)pednav::io::engine_options(*cfg).problems();
+    (void)pednav::pipeline::engine_options(*cfg).problems();
   } else {
     // Along-a-track scenarios name a track file: relative paths resolve under a folder that does not exist.
     auto sc = pednav::io::parse_scenario(text, "fuzz_scenario.yaml", "/nonexistent");

@@ -74,7 +74,7 @@ Expected<RunConfig> load_run_config(const std::string& path) {
 
 // docs/consistency.md §3.3-3.4: in mode tc the GNSS observes the scale factors and the turn-on biases, so the filter
 // gets the scale-factor states (gyro and accelerometer) and the random-walk bias model. In mode ins it gets the
-// scale-factor states only for an uncalibrated sensor, data-sheet gyro scale-factor σ ≥ 1 % (§3.15: 1 % of every
+// scale-factor states only for an uncalibrated sensor, data-sheet gyro scale-factor σ ≥ 1 % (§3.16: 1 % of every
 // turn is then its largest heading error; on calibrated sensors, 0.05-0.5 %, the states cost accuracy).
 ImuErrorModelChoice imu_error_model_choice(const RunConfig& c) {
   constexpr double kUncalibratedGyroScaleSigma = 0.01;

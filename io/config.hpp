@@ -135,7 +135,7 @@ struct ClockConfig {
 
 /// `multipath:` section: code-multipath Gauss-Markov states of the tc filter (docs/consistency.md §3).
 struct MultipathConfig {
-  bool states = true;               ///< one unit-variance GM state per tracked satellite (tc; default on since session 4)
+  bool states = true;               ///< one unit-variance GM state per tracked satellite (tc; on by default)
   double sigma_m = 0.28;            ///< multipath σ at C/N0 >= cn0_ref_dbhz [m] (per receiver)
   double tau_s = 20.0;              ///< correlation time [s]
   double cn0_ref_dbhz = 45.0;       ///< below, σ grows as 10^((ref − C/N0)/20)

@@ -7,7 +7,7 @@
 namespace pednav::io {
 
 Expected<void> write_residuals_csv(const std::string& path, const std::vector<fusion::GnssRowRecord>& records) {
-  // w_final appended (session 14): the columns before it keep their order.
+  // w_final is the last column (added after the others): the columns before it keep their order.
   std::string s = "gps_week,gps_tow_s,sat,type,innovation,sigma,w,mdb,rejected,w_final\n";
   s.reserve(s.size() + records.size() * 72);
   for (const auto& r : records) {

@@ -1,5 +1,5 @@
 // The simulator: scenario -> foot truth, IMU samples, antenna truth, rover/base GNSS observations and the
-// nominal constellation. Pure: returns data, writes nothing (io/simulate_command.* writes the files).
+// nominal constellation. Pure: returns data, writes nothing (pipeline/simulate_command.* writes the files).
 #pragma once
 
 #include <vector>

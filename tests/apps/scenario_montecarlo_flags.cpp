@@ -71,7 +71,7 @@ TEST(MontecarloFlags, NoDopplerChangesTheFilterAndRunsAreReproducible) {
 
 // Mode ins starts every run from the true position and heading, and its P must say so: with the configured 5 m / 10°
 // of a typed-in start, the σ ratios and NEES of an ins Monte Carlo measured the initial uncertainty, not the drift
-// (docs/consistency.md §3.15).
+// (docs/consistency.md §3.16).
 TEST(MontecarloFlags, InsRunsStartWithTheCovarianceOfTheTrueStart) {
   const std::string dir = test::temp_dir("mc_ins");
   const std::string scenario = dir + "/walk.yaml";

@@ -17,7 +17,7 @@
 #include <string>
 #include <thread>
 
-#include "io/simulate_command.hpp"
+#include "pipeline/simulate_command.hpp"
 #include "tests/sim/fixtures.hpp"
 
 namespace pednav {
@@ -67,7 +67,7 @@ TEST(RobustAtomicOutputs, KilledRunLeavesNoPartialFileUnderAFinalName) {
   const std::string exe = std::string(PEDNAV_BINARY_DIR) + "/bin/pednav";
   ASSERT_TRUE(std::filesystem::exists(exe)) << exe;
   const std::string dir = test::temp_dir("robust_kill");
-  auto sim = io::run_simulate_command(test::scenario_from_text(kWalkYaml), dir);
+  auto sim = pipeline::run_simulate_command(test::scenario_from_text(kWalkYaml), dir);
   ASSERT_TRUE(sim.has_value()) << sim.error().message;
   std::string cfg = test::read_text(dir + "/config.yaml");
   const auto m = cfg.find("mode: gnss");

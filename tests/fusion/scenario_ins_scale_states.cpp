@@ -1,4 +1,4 @@
-// Mode ins on an uncalibrated gyro (docs/consistency.md §3.15): the Crista's data-sheet gyro scale-factor σ is 1 %,
+// Mode ins on an uncalibrated gyro (docs/consistency.md §3.16): the Crista's data-sheet gyro scale-factor σ is 1 %,
 // so on datasets/indoor_loops (three corridor loops, 1080° of net turning) the unmodelled scale factors alone make
 // ~10° of heading error by the end. `scale_factors.states: auto` gives mode ins the scale-factor states for such a
 // sensor: the final error falls to ~0.2 % of the distance and the filter's yaw σ covers the yaw error. Fails if the
@@ -12,7 +12,7 @@
 #include "core/rotation.hpp"
 #include "fusion/engine.hpp"
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 #include "io/scenario_config.hpp"
 #include "sim/simulator.hpp"
 
@@ -36,7 +36,7 @@ Final run_ins(const sim::Simulation& s, bool auto_scale_states) {
   c.imu.spec = s.scenario.imu.spec;
   c.smoother_enabled = false;
   if (!auto_scale_states) c.scale_factors.states = false;
-  fusion::EngineOptions o = io::engine_options(c);
+  fusion::EngineOptions o = pipeline::engine_options(c);
   const ins::NavState& t0 = s.truth.nav.front();
   o.initial_position_e = t0.p_eb_e;
   o.initial_yaw_rad = yaw_n(t0);
@@ -63,7 +63,7 @@ Final run_ins(const sim::Simulation& s, bool auto_scale_states) {
 
 // Measured when written (seeds 41-60, 270 m each, at the last epoch): auto (states on) mean final error 0.202 % of
 // the distance, RMS yaw error / RMS yaw σ 1.14; states off 0.698 %, 4.73 (100-seed Monte Carlo, median over the
-// epochs of sample σ / filter σ of yaw: 0.99 vs 3.30, docs/consistency.md §3.15).
+// epochs of sample σ / filter σ of yaw: 0.99 vs 3.30, docs/consistency.md §3.16).
 constexpr int kSeeds = 20;
 constexpr double kDistanceM = 270.0;
 constexpr double kMaxMeanPctWith = 0.35;

@@ -14,7 +14,7 @@
 #include "core/geodesy.hpp"
 #include "fusion/engine.hpp"
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 #include "io/scenario_config.hpp"
 #include "sim/simulator.hpp"
 #include "tests/sim/fixtures.hpp"
@@ -78,7 +78,7 @@ fusion::EngineOptions options(const sim::Simulation& s, bool states) {
   c.mode = "tc";
   c.imu.spec = s.scenario.imu.spec;
   c.smoother_enabled = false;
-  fusion::EngineOptions o = io::engine_options(c);
+  fusion::EngineOptions o = pipeline::engine_options(c);
   o.base_position_e = s.gnss.p_base_e;
   o.multipath_sigma_m = states ? s.scenario.gnss.multipath_sigma_m : 0.0;
   o.multipath_tau_s = s.scenario.gnss.multipath_tau_s;

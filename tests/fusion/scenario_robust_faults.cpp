@@ -18,7 +18,7 @@
 #include "core/rotation.hpp"
 #include "fusion/engine.hpp"
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 #include "io/scenario_config.hpp"
 #include "sim/simulator.hpp"
 
@@ -74,7 +74,7 @@ Walk make_walk(int laps) {
   io::RunConfig c;  // the configuration `pednav simulate` writes, mode tc
   c.mode = "tc";
   c.imu.spec = file->scenario.imu.spec;
-  w.options = io::engine_options(c);
+  w.options = pipeline::engine_options(c);
   w.options.base_position_e = w.sim.gnss.p_base_e;
   w.options.smoother_enabled = false;
   return w;

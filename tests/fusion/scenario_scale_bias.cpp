@@ -18,7 +18,7 @@
 #include "fusion/engine.hpp"
 #include "ins/imu_spec.hpp"
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 #include "io/scenario_config.hpp"
 #include "sim/simulator.hpp"
 #include "tests/sim/fixtures.hpp"
@@ -87,7 +87,7 @@ TEST(ScaleBiasCompensation, RollGyroAndVerticalAccelScalesStayNearZeroOnlyWithTh
       c.imu.spec = *filter_spec;  // the filter keeps the Crista scale-factor prior
       c.smoother_enabled = false;
       c.scale_factors.bias_compensation = on == 1;
-      fusion::EngineOptions o = io::engine_options(c);
+      fusion::EngineOptions o = pipeline::engine_options(c);
       o.base_position_e = s->gnss.p_base_e;
       auto r = fusion::run_forward(test::engine_inputs(*s), o);
       ASSERT_TRUE(r.has_value()) << r.error().message;
@@ -138,7 +138,7 @@ TEST(ScaleBiasCompensation, SmoothedScaleFactorsAreConstantAndKeepTheSubtraction
   c.imu.spec = *filter_spec;
   c.smoother_enabled = true;
   c.scale_factors.bias_compensation = true;
-  fusion::EngineOptions o = io::engine_options(c);
+  fusion::EngineOptions o = pipeline::engine_options(c);
   o.base_position_e = s->gnss.p_base_e;
   auto r = fusion::run_forward(test::engine_inputs(*s), o);
   ASSERT_TRUE(r.has_value()) << r.error().message;
@@ -180,7 +180,7 @@ TEST(ScaleBiasCompensation, SmootherRemovesTheBiasInEveryComponent) {
       c.mode = "tc";
       c.imu.spec = *filter_spec;
       c.smoother_enabled = true;
-      fusion::EngineOptions o = io::engine_options(c);
+      fusion::EngineOptions o = pipeline::engine_options(c);
       o.smoother_eiv_regression = on == 1;
       o.base_position_e = s->gnss.p_base_e;
       auto r = fusion::run_forward(test::engine_inputs(*s), o);

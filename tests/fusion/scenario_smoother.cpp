@@ -13,7 +13,7 @@
 #include "core/geodesy.hpp"
 #include "fusion/engine.hpp"
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 #include "io/scenario_config.hpp"
 #include "sim/simulator.hpp"
 
@@ -88,7 +88,7 @@ class ForestWalkSmoother : public ::testing::Test {
     io::RunConfig c;  // the configuration `pednav simulate` writes, mode tc: defaults of io::RunConfig
     c.mode = "tc";
     c.imu.spec = file->scenario.imu.spec;
-    fusion::EngineOptions o = io::engine_options(c);
+    fusion::EngineOptions o = pipeline::engine_options(c);
     ASSERT_TRUE(o.smoother_enabled) << "smoother.enabled defaults to true";
     o.base_position_e = g->sim.gnss.p_base_e;
     fusion::EngineInputs in;

@@ -20,7 +20,7 @@
 #include "gnss/least_squares.hpp"
 #include "gnss/measurement.hpp"
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 #include "io/scenario_config.hpp"
 #include "sim/simulator.hpp"
 #include "tests/sim/fixtures.hpp"

@@ -15,7 +15,7 @@
 #include "core/rotation.hpp"
 #include "fusion/engine.hpp"
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 #include "sim/simulator.hpp"
 #include "tests/sim/fixtures.hpp"
 
@@ -35,7 +35,7 @@ EdgeRun run_ins(const sim::Simulation& s, double edge_s) {
   c.smoother_enabled = false;
   c.zupt.edge_s = edge_s;
   c.scale_factors.states = false;  // the exact IMU: nothing to estimate (mode ins would give crista its 1 % states)
-  fusion::EngineOptions o = io::engine_options(c);
+  fusion::EngineOptions o = pipeline::engine_options(c);
   const ins::NavState& t0 = s.truth.nav.front();
   o.initial_position_e = t0.p_eb_e;
   const Geodetic llh0 = geodetic_from_ecef(t0.p_eb_e);

@@ -13,7 +13,7 @@
 
 #include "fusion/engine.hpp"
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 #include "io/scenario_config.hpp"
 #include "sim/simulator.hpp"
 #include "tests/sim/fixtures.hpp"
@@ -60,7 +60,7 @@ void check_no_allocation_per_step(bool states) {
   io::RunConfig c;
   c.mode = "tc";
   c.imu.spec = file->scenario.imu.spec;
-  fusion::EngineOptions o = io::engine_options(c);
+  fusion::EngineOptions o = pipeline::engine_options(c);
   ASSERT_TRUE(o.smoother_enabled);
   if (states) {
     o.multipath_sigma_m = file->scenario.gnss.multipath_sigma_m;

@@ -10,7 +10,7 @@
 #include "fusion/engine.hpp"
 #include "io/config.hpp"
 #include "io/hmm_model_io.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 
 namespace pednav {
 namespace {
@@ -208,7 +208,7 @@ TEST(RunCommandBadInput, ImuLogWithoutAStillPeriodNamesTheConfig) {
       ", h_m: 1050, yaw_deg: 0}\n";
   auto c = io::parse_run_config(yaml, (dir / "run.yaml").string(), dir.string());
   ASSERT_TRUE(c) << c.error().message;
-  auto r = io::run_run_command(*c, (dir / "out").string());
+  auto r = pipeline::run_run_command(*c, (dir / "out").string());
   ASSERT_FALSE(r);
   EXPECT_THAT(r.error().message, HasSubstr("run.yaml: IMU: no still period found"));
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "solution.csv"));
@@ -218,7 +218,7 @@ TEST(RunCommandBadInput, ImuLogWithoutAStillPeriodNamesTheConfig) {
 TEST(RunCommandBadInput, ModeGnssIsRedirected) {
   auto c = io::parse_run_config("mode: gnss\nrover_obs: r.obs\nnav: n.rnx\n", "run.yaml", "/data");
   ASSERT_TRUE(c) << c.error().message;
-  auto r = io::run_run_command(*c, "/nonexistent/out");
+  auto r = pipeline::run_run_command(*c, "/nonexistent/out");
   ASSERT_FALSE(r);
   EXPECT_THAT(r.error().message, HasSubstr("mode gnss: use `pednav gnss`"));
 }

@@ -10,7 +10,7 @@
 #include "fusion/health.hpp"
 #include "ins/imu_spec.hpp"
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 
 namespace pednav {
 namespace {
@@ -72,7 +72,7 @@ TEST(EngineHealth, CovarianceDefectsAreNamed) {
 TEST(EngineHealth, RunWithoutImuSpecIsAConfigError) {
   auto cfg = io::parse_run_config("mode: ins\nimu:\n  file: imu.csv\n  format: pyshoe\n", "run.yaml", "/nonexistent");
   ASSERT_TRUE(cfg) << cfg.error().message;
-  auto r = io::run_run_command(*cfg, ::testing::TempDir() + "pednav_health_out");
+  auto r = pipeline::run_run_command(*cfg, ::testing::TempDir() + "pednav_health_out");
   ASSERT_FALSE(r);
   EXPECT_THAT(r.error().message, HasSubstr("run.yaml: imu.spec: required for pednav run"));
 }

@@ -3,10 +3,12 @@
 
 #include "core/geodesy.hpp"
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 
 namespace pednav::io {
 namespace {
+
+using pipeline::engine_options;  // RunConfig -> fusion::EngineOptions (pipeline/run_command.hpp)
 
 using ::testing::HasSubstr;
 
@@ -110,6 +112,8 @@ TEST(Config, ResolvedYamlParsesBackToTheSameConfig) {
 namespace pednav::io {
 namespace {
 
+using pipeline::engine_options;  // RunConfig -> fusion::EngineOptions (pipeline/run_command.hpp)
+
 TEST(Config, AccelOnlyScaleStatesAndBiasModelKeys) {
   auto cfg = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\nscale_factors:\n  states: true\n  gyro: false\n"
                    "bias:\n  model: random_walk\n");
@@ -130,7 +134,7 @@ TEST(Config, AccelOnlyScaleStatesAndBiasModelKeys) {
   EXPECT_THAT(bad.error().message, HasSubstr("scale_factors.states: expected one of {auto, true, false}, got 'maybe'"));
 }
 
-// The defaults depend on the mode (docs/consistency.md §3.3, §3.15): tc gets scale-factor states and the random-walk
+// The defaults depend on the mode (docs/consistency.md §3.3, §3.16): tc gets scale-factor states and the random-walk
 // bias model, ins the scale-factor states only for an uncalibrated (≥ 1 %) gyro; explicit keys win; the resolved configuration writes what was used.
 TEST(Config, ImuErrorModelDefaultsDependOnTheMode) {
   const std::string files = "rover_obs: r.obs\nnav: n.nav\nimu: {file: i.csv, format: pyshoe, spec: crista}\n";
@@ -147,7 +151,7 @@ TEST(Config, ImuErrorModelDefaultsDependOnTheMode) {
   m = imu_error_model_choice(*tc_acc);
   EXPECT_TRUE(m.scale_states);
   EXPECT_FALSE(m.gyro_scale_states);
-  auto ins = parse("mode: ins\n" + files);  // crista: gyro scale-factor σ 1 %, uncalibrated (§3.15)
+  auto ins = parse("mode: ins\n" + files);  // crista: gyro scale-factor σ 1 %, uncalibrated (§3.16)
   ASSERT_TRUE(ins) << ins.error().message;
   m = imu_error_model_choice(*ins);
   EXPECT_TRUE(m.scale_states);

@@ -8,9 +8,9 @@
 #include "core/geodesy.hpp"
 #include "fusion/engine.hpp"
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 #include "io/scenario_config.hpp"
-#include "io/simulate_command.hpp"
+#include "pipeline/simulate_command.hpp"
 #include "io/trajectory_io.hpp"
 #include "tests/sim/fixtures.hpp"
 #include "tests/support/data.hpp"
@@ -38,7 +38,7 @@ TEST(GalwayTrack, FootImuAlongTheRealRtkTrack) {
   auto sc = io::load_scenario(test::source_path("datasets/galway_track.yaml"));
   ASSERT_TRUE(sc.has_value()) << (sc ? "" : sc.error().message);
   const std::string dir = test::temp_dir("galway_track");
-  auto sum = io::run_simulate_command(*sc, dir);
+  auto sum = pipeline::run_simulate_command(*sc, dir);
   ASSERT_TRUE(sum.has_value()) << (sum ? "" : sum.error().message);
   EXPECT_GT(sum->strides, 150);
   EXPECT_EQ(sum->rover_epochs, 0);  // the GNSS is the real one
@@ -71,12 +71,12 @@ TEST(GalwayTrack, TightlyCoupledOnTheRealGnssAgainstRtkFixed) {
   auto sc = io::load_scenario(test::source_path("datasets/galway_track.yaml"));
   ASSERT_TRUE(sc.has_value()) << (sc ? "" : sc.error().message);
   const std::string dir = test::temp_dir("galway_track_tc");
-  auto sum = io::run_simulate_command(*sc, dir);
+  auto sum = pipeline::run_simulate_command(*sc, dir);
   ASSERT_TRUE(sum.has_value()) << (sum ? "" : sum.error().message);
   auto cfg = io::load_run_config(dir + "/config.yaml");
   ASSERT_TRUE(cfg.has_value()) << (cfg ? "" : cfg.error().message);
   cfg->mode = "tc";
-  auto data = io::load_run_inputs(*cfg);
+  auto data = pipeline::load_run_inputs(*cfg);
   ASSERT_TRUE(data.has_value()) << (data ? "" : data.error().message);
   auto r = fusion::run_forward(data->engine_inputs(), data->options);
   ASSERT_TRUE(r.has_value()) << (r ? "" : r.error().message);

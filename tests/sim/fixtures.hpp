@@ -13,7 +13,7 @@
 
 #include "fusion/engine.hpp"
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 #include "io/scenario_config.hpp"
 #include "sim/simulator.hpp"
 
@@ -93,7 +93,7 @@ inline fusion::EngineOptions tc_default_options(const io::ScenarioFile& file, co
   io::RunConfig c;
   c.mode = "tc";
   c.imu.spec = file.scenario.imu.spec;
-  fusion::EngineOptions o = io::engine_options(c);
+  fusion::EngineOptions o = pipeline::engine_options(c);
   o.base_position_e = s.gnss.p_base_e;
   return o;
 }

@@ -8,9 +8,9 @@
 
 #include "eval/trajectory.hpp"
 #include "io/config.hpp"
-#include "io/gnss_command.hpp"
+#include "pipeline/gnss_command.hpp"
 #include "io/scenario_config.hpp"
-#include "io/simulate_command.hpp"
+#include "pipeline/simulate_command.hpp"
 #include "io/trajectory_io.hpp"
 #include "tests/sim/fixtures.hpp"
 #include "tests/support/data.hpp"
@@ -27,7 +27,7 @@ TEST(ForestWalk, PednavGnssLandsOnSeed004Table1) {
   ASSERT_TRUE(sc.has_value()) << (sc ? "" : sc.error().message);
   const std::string dir = test::temp_dir("forest_walk");
   const auto t0 = std::chrono::steady_clock::now();
-  auto sum = io::run_simulate_command(*sc, dir);
+  auto sum = pipeline::run_simulate_command(*sc, dir);
   const double gen_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_TRUE(sum.has_value()) << (sum ? "" : sum.error().message);
   EXPECT_LT(gen_s, kMaxGenerate_s);
@@ -40,7 +40,7 @@ TEST(ForestWalk, PednavGnssLandsOnSeed004Table1) {
   // Seed 004's GPS-only solution is raw epoch-by-epoch code: calibrate against it without pednav's Doppler smoothing
   // (with the default 10 s smoothing: 4.62 m, 86.5 % < 5 m; docs/results.md).
   cfg->gnss.code_smoothing_s = 0.0;
-  auto g = io::run_gnss_command(*cfg, dir + "/G");
+  auto g = pipeline::run_gnss_command(*cfg, dir + "/G");
   ASSERT_TRUE(g.has_value()) << (g ? "" : g.error().message);
   auto sol = io::read_trajectory(dir + "/G/gnss.csv", {});
   auto ref = io::read_trajectory(dir + "/truth.csv", {});

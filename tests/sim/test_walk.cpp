@@ -11,7 +11,7 @@
 #include "ins/mechanization.hpp"
 #include "io/config.hpp"
 #include "io/imu_csv.hpp"
-#include "io/simulate_command.hpp"
+#include "pipeline/simulate_command.hpp"
 #include "sim/simulator.hpp"
 #include "tests/sim/fixtures.hpp"
 
@@ -84,12 +84,12 @@ class NoiseFreeWalk : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = test::temp_dir("noise_free_walk");
-    auto sum = io::run_simulate_command(test::scenario_from_text(test::kNoiseFreeWalkYaml), dir_);
+    auto sum = pipeline::run_simulate_command(test::scenario_from_text(test::kNoiseFreeWalkYaml), dir_);
     ASSERT_TRUE(sum.has_value()) << (sum ? "" : sum.error().message);
     summary_ = *sum;
   }
   static inline std::string dir_;
-  static inline io::SimulateSummary summary_;
+  static inline pipeline::SimulateSummary summary_;
 };
 
 TEST_F(NoiseFreeWalk, MechanizedImuCsvStaysOnTruthCsvAt20Hz) {

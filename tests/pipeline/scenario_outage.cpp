@@ -9,10 +9,10 @@
 #include <nlohmann/json.hpp>
 
 #include "io/config.hpp"
-#include "io/outage_command.hpp"
+#include "pipeline/outage_command.hpp"
 #include "io/report.hpp"
 #include "io/scenario_config.hpp"
-#include "io/simulate_command.hpp"
+#include "pipeline/simulate_command.hpp"
 #include "tests/sim/fixtures.hpp"
 
 namespace pednav {
@@ -30,7 +30,7 @@ class OutageCommand : public ::testing::Test {
     dir_ = new std::string(test::temp_dir("outage_sim"));
     auto f = io::load_scenario("datasets/circle_304m.yaml");  // 243 s: 30 s still, 304 m walked, open sky
     ASSERT_TRUE(f.has_value()) << f.error().message;
-    ASSERT_TRUE(io::run_simulate_command(*f, *dir_).has_value());
+    ASSERT_TRUE(pipeline::run_simulate_command(*f, *dir_).has_value());
   }
   static void TearDownTestSuite() {
     delete dir_;
@@ -42,8 +42,8 @@ class OutageCommand : public ::testing::Test {
     c->mode = "tc";
     return *c;
   }
-  static io::OutageArgs args(const std::string& name, int keep) {
-    io::OutageArgs a;
+  static pipeline::OutageArgs args(const std::string& name, int keep) {
+    pipeline::OutageArgs a;
     a.out_dir = *dir_ + "/" + name;
     a.windows = kWindows;
     a.duration_s = kWindowS;
@@ -58,8 +58,8 @@ class OutageCommand : public ::testing::Test {
 std::string* OutageCommand::dir_ = nullptr;
 
 TEST_F(OutageCommand, PartialKeepsAtMostNSatellitesAndWritesTheDesignOutputs) {
-  const io::OutageArgs a = args("keep3", 3);
-  auto r = io::run_outage_command(config(), a);
+  const pipeline::OutageArgs a = args("keep3", 3);
+  auto r = pipeline::run_outage_command(config(), a);
   ASSERT_TRUE(r.has_value()) << r.error().message;
   ASSERT_EQ(r->windows.size(), static_cast<size_t>(kWindows));
   EXPECT_EQ(r->against, "reference");  // simulate's config.yaml names truth.csv
@@ -101,7 +101,7 @@ TEST_F(OutageCommand, PartialKeepsAtMostNSatellitesAndWritesTheDesignOutputs) {
 }
 
 TEST_F(OutageCommand, FullOutageEmptiesEpochsAndDriftsFromTheRunWithoutOutage) {
-  auto r = io::run_outage_command(config(), args("full", 0));
+  auto r = pipeline::run_outage_command(config(), args("full", 0));
   ASSERT_TRUE(r.has_value()) << r.error().message;
   for (int k = 0; k < kWindows; ++k) {
     EXPECT_GE(r->epochs_masked[k], static_cast<long>(kWindowS) - 1) << k;
@@ -115,8 +115,8 @@ TEST_F(OutageCommand, FullOutageEmptiesEpochsAndDriftsFromTheRunWithoutOutage) {
 TEST_F(OutageCommand, SmoothedColumnsAreEmptyWithoutASmoother) {
   io::RunConfig c = config();
   c.smoother_enabled = false;
-  const io::OutageArgs a = args("nosmooth", 3);
-  auto r = io::run_outage_command(c, a);
+  const pipeline::OutageArgs a = args("nosmooth", 3);
+  auto r = pipeline::run_outage_command(c, a);
   ASSERT_TRUE(r.has_value()) << r.error().message;
   EXPECT_FALSE(r->has_smoothed);
   const std::string csv = test::read_text(a.out_dir + "/outages.csv");
@@ -135,17 +135,17 @@ TEST_F(OutageCommand, SmoothedColumnsAreEmptyWithoutASmoother) {
 }
 
 TEST_F(OutageCommand, BadOptionsAreNamed) {
-  io::OutageArgs a = args("bad", 3);
+  pipeline::OutageArgs a = args("bad", 3);
   a.windows = 50;
-  auto r = io::run_outage_command(config(), a);
+  auto r = pipeline::run_outage_command(config(), a);
   ASSERT_FALSE(r.has_value());
   EXPECT_THAT(r.error().message, HasSubstr("50 x 20 s do not fit"));
   a = args("bad2", 3);
   a.against = "truth";
-  EXPECT_THAT(io::run_outage_command(config(), a).error().message, HasSubstr("--against: expected auto"));
+  EXPECT_THAT(pipeline::run_outage_command(config(), a).error().message, HasSubstr("--against: expected auto"));
   a = args("bad3", 3);
   a.start_tow_s = {1.0};
-  EXPECT_THAT(io::run_outage_command(config(), a).error().message, HasSubstr("is outside the run"));
+  EXPECT_THAT(pipeline::run_outage_command(config(), a).error().message, HasSubstr("is outside the run"));
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 // `pednav simulate` outputs (docs/sim.md §7): the simulator's data formatted and written atomically.
-#include "io/simulate_command.hpp"
+#include "pipeline/simulate_command.hpp"
 
 #include <fmt/format.h>
 
@@ -12,7 +12,9 @@
 #include "io/rinex_writer.hpp"
 #include "sim/gnss_sim.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
+
+using namespace pednav::io;  // the readers, writers and configuration this use case drives
 namespace {
 
 long truth_step(const sim::Simulation& s) {
@@ -231,4 +233,4 @@ Expected<SimulateSummary> run_simulate_command(const ScenarioFile& file, const s
   return sum;
 }
 
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

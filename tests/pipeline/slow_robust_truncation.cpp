@@ -14,7 +14,7 @@
 #include "gnss/rtklib/rinex.hpp"
 #include "io/config.hpp"
 #include "io/imu_csv.hpp"
-#include "io/simulate_command.hpp"
+#include "pipeline/simulate_command.hpp"
 #include "tests/sim/fixtures.hpp"
 
 namespace pednav {
@@ -51,7 +51,7 @@ std::string write_cut(const std::string& path, const std::string& text, size_t c
 
 TEST(SlowRobustTruncation, RoverObsCutAtEveryLineEndAndMidLineGivesAPrefixOrAClearError) {
   const std::string dir = test::temp_dir("robust_truncation_sweep");
-  auto sim = io::run_simulate_command(test::scenario_from_text(kWalkYaml), dir);
+  auto sim = pipeline::run_simulate_command(test::scenario_from_text(kWalkYaml), dir);
   ASSERT_TRUE(sim.has_value()) << sim.error().message;
   const std::string text = test::read_text(dir + "/rover.obs");
   const gnss::SystemSelection all{true, true, true, true, true};
@@ -102,7 +102,7 @@ TEST(SlowRobustTruncation, RoverObsCutAtEveryLineEndAndMidLineGivesAPrefixOrACle
 
 TEST(SlowRobustTruncation, ImuLogCutAtManyLineEndsAndMidLinesGivesAPrefixOrAClearError) {
   const std::string dir = test::temp_dir("robust_truncation_sweep_imu");
-  auto sim = io::run_simulate_command(test::scenario_from_text(kWalkYaml), dir);
+  auto sim = pipeline::run_simulate_command(test::scenario_from_text(kWalkYaml), dir);
   ASSERT_TRUE(sim.has_value()) << sim.error().message;
   const std::string text = test::read_text(dir + "/imu.csv");
   auto cfg = io::load_run_config(dir + "/config.yaml");

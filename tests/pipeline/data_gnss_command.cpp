@@ -12,11 +12,13 @@
 #include "core/geodesy.hpp"
 #include "gnss/types.hpp"
 #include "io/config.hpp"
-#include "io/gnss_command.hpp"
+#include "pipeline/gnss_command.hpp"
 #include "tests/support/data.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
 namespace {
+
+using namespace pednav::io;
 
 using ::testing::HasSubstr;
 using test::shared_data;
@@ -326,4 +328,4 @@ TEST(GnssCommandBadInput, NoCommonSatellites) {
 }
 
 }  // namespace
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

@@ -15,8 +15,8 @@
 #include "gnss/rtklib/rinex.hpp"
 #include "io/config.hpp"
 #include "io/imu_csv.hpp"
-#include "io/run_command.hpp"
-#include "io/simulate_command.hpp"
+#include "pipeline/run_command.hpp"
+#include "pipeline/simulate_command.hpp"
 #include "tests/sim/fixtures.hpp"
 
 namespace pednav {
@@ -33,7 +33,7 @@ const std::string kShortWalkYaml = test::small_rectangle_walk_yaml("robust_trunc
 const std::string& sim_dir() {
   static const std::string d = [] {
     const std::string dir = test::temp_dir("robust_truncation");
-    auto r = io::run_simulate_command(test::scenario_from_text(kShortWalkYaml), dir);
+    auto r = pipeline::run_simulate_command(test::scenario_from_text(kShortWalkYaml), dir);
     EXPECT_TRUE(r.has_value()) << (r ? "" : r.error().message);
     return dir;
   }();
@@ -151,7 +151,7 @@ TEST(RobustRunTruncation, RunOnCutFilesCompletesWithTruncationReportedOrFailsCle
     else c.imu.file = write_cut("run_cut_imu.csv", imu, cut);
     const std::string out = sim_dir() + "/out_" + what;
     std::filesystem::remove_all(out);
-    auto r = io::run_run_command(c, out);
+    auto r = pipeline::run_run_command(c, out);
     if (!r) {
       EXPECT_THAT(r.error().message, HasSubstr(what == "obs" ? "run_cut.obs" : "run_cut_imu.csv"));
       continue;
@@ -190,7 +190,7 @@ TEST(RobustAccounting, SummaryJsonIdentityHolds) {
   c->mode = "tc";
   c->imu.file = write_cut("acc_imu.csv", imu, imu.size());
   const std::string out = sim_dir() + "/out_accounting";
-  auto r = io::run_run_command(*c, out);
+  auto r = pipeline::run_run_command(*c, out);
   ASSERT_TRUE(r) << r.error().message;
   const auto j = nlohmann::json::parse(test::read_text(out + "/summary.json"));
   const auto& a = j["accounting"];

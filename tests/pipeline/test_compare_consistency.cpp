@@ -8,10 +8,12 @@
 #include <nlohmann/json.hpp>
 
 #include "core/geodesy.hpp"
-#include "io/compare_command.hpp"
+#include "pipeline/compare_command.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
 namespace {
+
+using namespace pednav::io;
 
 const Eigen::Vector3d kOrigin_e = ecef_from_geodetic({51.08 * kDegToRad, -114.13 * kDegToRad, 1050.0});
 
@@ -74,4 +76,4 @@ TEST(CompareConsistency, NoConsistencyBlockAfterARotatingAlignment) {
 }
 
 }  // namespace
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

@@ -1,4 +1,4 @@
-#include "io/outage_command.hpp"
+#include "pipeline/outage_command.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -22,11 +22,13 @@
 #include "io/imu_csv.hpp"
 #include "io/log.hpp"
 #include "io/plot.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 #include "io/solution_writer.hpp"
 #include "io/trajectory_io.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
+
+using namespace pednav::io;  // the readers, writers and configuration this use case drives
 namespace {
 
 using SatKeep = std::map<int64_t, std::vector<gnss::SatId>>;  // rover epoch time [ns] -> satellites kept
@@ -458,4 +460,4 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
   return res;
 }
 
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

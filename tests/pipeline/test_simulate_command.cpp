@@ -1,4 +1,4 @@
-// `pednav simulate` outputs (io/simulate_command.*): same seed -> byte-identical files; a different seed
+// `pednav simulate` outputs (pipeline/simulate_command.*): same seed -> byte-identical files; a different seed
 // changes them; config.yaml loads as a run configuration pointing at the written files; config_datasheet.yaml
 // loads to the scenario's own sensor models.
 #include <gtest/gtest.h>
@@ -6,8 +6,8 @@
 #include <filesystem>
 
 #include "io/config.hpp"
-#include "io/run_command.hpp"
-#include "io/simulate_command.hpp"
+#include "pipeline/run_command.hpp"
+#include "pipeline/simulate_command.hpp"
 #include "sim/gnss_sim.hpp"
 #include "tests/sim/fixtures.hpp"
 
@@ -27,9 +27,9 @@ io::ScenarioFile short_walk(uint64_t seed) {
 
 TEST(SimulateCommand, SameSeedGivesByteIdenticalFiles) {
   const std::string a = test::temp_dir("sim_a"), b = test::temp_dir("sim_b"), c = test::temp_dir("sim_c");
-  ASSERT_TRUE(io::run_simulate_command(short_walk(7), a).has_value());
-  ASSERT_TRUE(io::run_simulate_command(short_walk(7), b).has_value());
-  ASSERT_TRUE(io::run_simulate_command(short_walk(8), c).has_value());
+  ASSERT_TRUE(pipeline::run_simulate_command(short_walk(7), a).has_value());
+  ASSERT_TRUE(pipeline::run_simulate_command(short_walk(7), b).has_value());
+  ASSERT_TRUE(pipeline::run_simulate_command(short_walk(8), c).has_value());
   for (const char* f : kFiles) {
     const std::string ta = test::read_text(a + "/" + f), tb = test::read_text(b + "/" + f);
     ASSERT_FALSE(ta.empty()) << f;
@@ -43,7 +43,7 @@ TEST(SimulateCommand, SameSeedGivesByteIdenticalFiles) {
 
 TEST(SimulateCommand, ConfigYamlIsARunConfigurationOnTheWrittenFiles) {
   const std::string d = test::temp_dir("sim_cfg");
-  ASSERT_TRUE(io::run_simulate_command(short_walk(3), d).has_value());
+  ASSERT_TRUE(pipeline::run_simulate_command(short_walk(3), d).has_value());
   auto cfg = io::load_run_config(d + "/config.yaml");
   ASSERT_TRUE(cfg.has_value()) << (cfg ? "" : cfg.error().message);
   EXPECT_EQ(cfg->mode, "gnss");
@@ -68,7 +68,7 @@ TEST(SimulateCommand, DataSheetConfigLoadsToTheScenarioSensorModels) {
   f.scenario.gait.foot_offset_m = 0.12;
   const sim::Scenario& sc = f.scenario;
   const std::string d = test::temp_dir("sim_ds");
-  ASSERT_TRUE(io::run_simulate_command(f, d).has_value());
+  ASSERT_TRUE(pipeline::run_simulate_command(f, d).has_value());
   auto plain = io::load_run_config(d + "/config.yaml");
   auto ds = io::load_run_config(d + "/config_datasheet.yaml");
   ASSERT_TRUE(plain.has_value()) << plain.error().message;
@@ -92,8 +92,8 @@ TEST(SimulateCommand, DataSheetConfigLoadsToTheScenarioSensorModels) {
   // The same filter as pednav montecarlo's flags (apply_data_sheet on config.yaml) — every other key as config.yaml.
   io::RunConfig want = *plain;
   want.mode = "tc";
-  io::apply_data_sheet(sc, io::DataSheetParts::all(), want);
-  const fusion::EngineOptions a = io::engine_options(*ds), b = io::engine_options(want);
+  pipeline::apply_data_sheet(sc, pipeline::DataSheetParts::all(), want);
+  const fusion::EngineOptions a = pipeline::engine_options(*ds), b = pipeline::engine_options(want);
   EXPECT_DOUBLE_EQ(a.weights.code_sigma_zenith_m, b.weights.code_sigma_zenith_m);
   EXPECT_DOUBLE_EQ(a.weights.doppler_sigma_zenith_mps, b.weights.doppler_sigma_zenith_mps);
   EXPECT_DOUBLE_EQ(a.weights.cn0_ref_dbhz, b.weights.cn0_ref_dbhz);
@@ -112,7 +112,7 @@ TEST(SimulateCommand, DataSheetConfigLoadsToTheScenarioSensorModels) {
   // A simulated multipath below the configuration's 1 mm minimum: no multipath states (the file still loads).
   f.scenario.gnss.multipath_sigma_m = 1e-4;
   const std::string d2 = test::temp_dir("sim_ds2");
-  ASSERT_TRUE(io::run_simulate_command(f, d2).has_value());
+  ASSERT_TRUE(pipeline::run_simulate_command(f, d2).has_value());
   auto ds2 = io::load_run_config(d2 + "/config_datasheet.yaml");
   ASSERT_TRUE(ds2.has_value()) << ds2.error().message;
   EXPECT_FALSE(ds2->multipath.states);

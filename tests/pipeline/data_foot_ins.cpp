@@ -16,13 +16,15 @@
 #include <utility>
 #include <vector>
 
-#include "io/compare_command.hpp"
+#include "pipeline/compare_command.hpp"
 #include "io/config.hpp"
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 #include "tests/support/data.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
 namespace {
+
+using namespace pednav::io;
 
 // x-io short_walk, shoe gamma 10, form D: closure measured 0.102 m (x-io's own ZUPT result: 0.082 m); 2.10 m before
 // the initial heading σ was carried outside the filter (docs/fusion.md §5.5), so the bound fails without it.
@@ -31,7 +33,7 @@ constexpr double kXioShortClosureMax_m = 0.15;
 constexpr double kXioShortDistanceMin_m = 20.0;
 constexpr double kXioShortDistanceMax_m = 40.0;
 // PyShoe trials, same configuration (one for the GX5-25: PyShoe's process noise, SHOE γ 1.5, gait-adaptive α 3 next to
-// a swing, every stance sample, ZARU gate; docs/results.md "Session 21", "Session 23"), mean horizontal error after
+// a swing, every stance sample, ZARU gate; docs/results.md "INS/ZUPT on real foot data"), mean horizontal error after
 // start alignment. Measured 0.0438 / 0.117 / 0.096 / 0.0435 m (PyShoe tuned per trial: 0.045 / 0.132 / 0.112 / 0.047 m),
 // so every trial is bounded by the target. Before session 21: 0.091 / 0.613 / 2.781 / 0.114 m. Each bound fails
 // without the change it guards (re-measured with γ 1.5): with γ 3 (session 22) trials 1 / 4 are 0.050 / 0.051 m;
@@ -286,4 +288,4 @@ TEST(DataFootIns, PyshoeTrialWithPyshoesOwnStanceLabels) {
 }
 
 }  // namespace
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

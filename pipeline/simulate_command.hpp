@@ -10,7 +10,7 @@
 #include "io/scenario_config.hpp"
 #include "sim/simulator.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
 
 /// What was written (for the log line and tests).
 struct SimulateSummary {
@@ -33,7 +33,7 @@ std::string format_truth_csv(const sim::Simulation& sim);
 /// y right, z down).
 std::string format_imu_csv(const sim::Simulation& sim);
 /// config.yaml text for `pednav run`/`pednav gnss` on the written files (mode gnss until `run` exists).
-std::string format_run_config(const sim::Simulation& sim, const ScenarioFile& scenario);
+std::string format_run_config(const sim::Simulation& sim, const io::ScenarioFile& scenario);
 
 /// The parts of a simulated sensor's description that a run configuration can take from the scenario instead of
 /// `pednav run`'s generic defaults — what a user copies from the data sheets and a tape measure (docs/sim.md §7,
@@ -48,15 +48,15 @@ struct DataSheetParts {
 
 /// Overwrite the parts of `c` that `parts` names with the scenario's own models (the rest stays as it is).
 /// A simulated multipath σ under the configuration's 1 mm minimum turns the multipath states off.
-void apply_data_sheet(const sim::Scenario& scenario, const DataSheetParts& parts, RunConfig& c);
+void apply_data_sheet(const sim::Scenario& scenario, const DataSheetParts& parts, io::RunConfig& c);
 
 /// config_datasheet.yaml text: config.yaml in mode tc (ins without GNSS) with every data-sheet part that applies —
 /// all four with simulated GNSS; lever arm and g-sensitivity with real GNSS files (the receiver is not simulated);
 /// g-sensitivity alone without GNSS. It loads to the configuration `pednav montecarlo --receiver-weights
 /// --scenario-lever-arm --g-sensitivity-states --multipath-states` gives its runs.
-std::string format_data_sheet_config(const sim::Simulation& sim, const ScenarioFile& scenario);
+std::string format_data_sheet_config(const sim::Simulation& sim, const io::ScenarioFile& scenario);
 
 /// Run a scenario and write every output into out_dir (created).
-Expected<SimulateSummary> run_simulate_command(const ScenarioFile& scenario, const std::string& out_dir);
+Expected<SimulateSummary> run_simulate_command(const io::ScenarioFile& scenario, const std::string& out_dir);
 
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

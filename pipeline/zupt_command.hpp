@@ -9,7 +9,7 @@
 #include "io/config.hpp"
 #include "io/hmm_model_io.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
 
 /// What `pednav zupt` found.
 struct ZuptCommandSummary {
@@ -32,11 +32,11 @@ struct ZuptCommandSummary {
 
 /// Run the configured detector (config.zupt) over config.imu.file; writes out_dir/zupt.csv (gps_week, gps_tow_s,
 /// stance, statistic, hmm_state, hmm_grade), out_dir/summary.json and the detections plot out_dir/zupt.svg (gnuplot).
-Expected<ZuptCommandSummary> run_zupt_command(const RunConfig& config, const std::string& out_dir);
+Expected<ZuptCommandSummary> run_zupt_command(const io::RunConfig& config, const std::string& out_dir);
 
 /// Train the HMM on the IMU logs of `configs` (all with the same hmm extraction keys), starting from the first
 /// config's zupt.hmm_model or seed 002's initial model; writes hmm.yaml to out_path.
-Expected<HmmModelFile> run_hmm_train_command(const std::vector<RunConfig>& configs, const std::string& out_path,
+Expected<io::HmmModelFile> run_hmm_train_command(const std::vector<io::RunConfig>& configs, const std::string& out_path,
                                              int max_iterations);
 
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

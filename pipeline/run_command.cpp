@@ -1,4 +1,4 @@
-#include "io/run_command.hpp"
+#include "pipeline/run_command.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -14,13 +14,15 @@
 #include "gnss/rtklib/rinex.hpp"
 #include "io/atomic_file.hpp"
 #include "io/residuals_writer.hpp"
-#include "io/compare_command.hpp"
+#include "pipeline/compare_command.hpp"
 #include "io/hmm_model_io.hpp"
 #include "io/imu_csv.hpp"
 #include "io/solution_writer.hpp"
 #include "io/trajectory_io.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
+
+using namespace pednav::io;  // the readers, writers and configuration this use case drives
 namespace {
 
 gnss::System system_of(const std::string& letter) {
@@ -396,4 +398,4 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
   return sum;
 }
 
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

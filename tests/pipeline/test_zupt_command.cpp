@@ -1,4 +1,4 @@
-// `pednav zupt` (io::run_zupt_command): zupt.csv / summary.json, and the agreement of a detector with the stance
+// `pednav zupt` (pipeline::run_zupt_command): zupt.csv / summary.json, and the agreement of a detector with the stance
 // labels of the log (imu.format stance.column) — PyShoe's stored labels, or any reference the user has.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -11,10 +11,12 @@
 #include <string>
 
 #include "io/config.hpp"
-#include "io/zupt_command.hpp"
+#include "pipeline/zupt_command.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
 namespace {
+
+using namespace pednav::io;
 
 using ::testing::HasSubstr;
 
@@ -91,4 +93,4 @@ TEST(ZuptCommand, DetectorScoredAgainstTheLogsStanceLabels) {
 }
 
 }  // namespace
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

@@ -11,7 +11,7 @@
 #include "eval/outage.hpp"
 #include "io/config.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
 
 struct OutageArgs {
   std::string out_dir;
@@ -50,6 +50,6 @@ struct OutageResult {
 };
 
 /// Run the study for a loaded configuration (mode tc) and write the outputs into args.out_dir.
-Expected<OutageResult> run_outage_command(const RunConfig& config, const OutageArgs& args);
+Expected<OutageResult> run_outage_command(const io::RunConfig& config, const OutageArgs& args);
 
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

@@ -1,4 +1,4 @@
-#include "io/compare_command.hpp"
+#include "pipeline/compare_command.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -17,7 +17,9 @@
 #include "io/plot_figures.hpp"
 #include "io/report.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
+
+using namespace pednav::io;  // the readers, writers and configuration this use case drives
 namespace {
 
 const char* align_name(eval::Align a) {
@@ -210,4 +212,4 @@ Expected<eval::Evaluation> run_compare(const CompareArgs& args) {
   return ev;
 }
 
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

@@ -10,7 +10,7 @@
 #include "gnss/epoch_matching.hpp"
 #include "io/config.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
 
 /// Counts reported in summary.json.
 struct GnssRunSummary {
@@ -26,6 +26,6 @@ struct GnssRunSummary {
 };
 
 /// Run the GNSS-only solution for a loaded configuration and write the outputs into out_dir (created).
-Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::string& out_dir);
+Expected<GnssRunSummary> run_gnss_command(const io::RunConfig& config, const std::string& out_dir);
 
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

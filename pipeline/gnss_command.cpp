@@ -1,5 +1,5 @@
 // `pednav gnss`: read rover/base/nav, match epochs, solve each epoch, write gnss.csv, gnss.pos, summary.json.
-#include "io/gnss_command.hpp"
+#include "pipeline/gnss_command.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -16,7 +16,9 @@
 #include "io/log.hpp"
 #include "io/solution_writer.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
+
+using namespace pednav::io;  // the readers, writers and configuration this use case drives
 namespace {
 
 gnss::SystemSelection selection(const std::vector<std::string>& systems) {
@@ -254,4 +256,4 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
   return sum;
 }
 
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

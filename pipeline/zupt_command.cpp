@@ -1,4 +1,4 @@
-#include "io/zupt_command.hpp"
+#include "pipeline/zupt_command.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -13,7 +13,9 @@
 #include "io/imu_csv.hpp"
 #include "io/plot.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
+
+using namespace pednav::io;  // the readers, writers and configuration this use case drives
 namespace {
 
 Expected<ImuLog> read_log(const RunConfig& c) {
@@ -198,4 +200,4 @@ Expected<HmmModelFile> run_hmm_train_command(const std::vector<RunConfig>& confi
   return f;
 }
 
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

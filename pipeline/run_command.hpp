@@ -13,15 +13,15 @@
 #include "io/imu_csv.hpp"
 #include "io/solution_writer.hpp"
 
-namespace pednav::io {
+namespace pednav::pipeline {
 
 /// Map the validated configuration onto the engine options (IMU spec, ZUPT, GNSS weights, antenna, clock).
-fusion::EngineOptions engine_options(const RunConfig& config);
+fusion::EngineOptions engine_options(const io::RunConfig& config);
 
 /// The inputs of a run, read once: the IMU log and, in tc mode, rover/base observations and navigation data, with
 /// the engine options (base position from the configuration, else the RINEX header with a warning).
 struct RunInputs {
-  ImuLog imu;
+  io::ImuLog imu;
   std::optional<gnss::ObsData> rover, base;
   std::optional<gnss::NavData> nav;
   fusion::EngineOptions options;
@@ -30,13 +30,13 @@ struct RunInputs {
 };
 
 /// Read what a `pednav run` (or an outage study) of this configuration needs; errors name the file and key.
-Expected<RunInputs> load_run_inputs(const RunConfig& config);
+Expected<RunInputs> load_run_inputs(const io::RunConfig& config);
 
 /// One solution.csv / smoothed.csv row of an output epoch (IMU position, NED velocity, attitude, σ; pos quality 4
 /// with satellites used, else 5).
-SolutionRow solution_row(const fusion::EpochOutput& e);
+io::SolutionRow solution_row(const fusion::EpochOutput& e);
 
 /// Run `pednav run` for a loaded configuration and write the outputs into out_dir (created).
-Expected<fusion::EngineSummary> run_run_command(const RunConfig& config, const std::string& out_dir);
+Expected<fusion::EngineSummary> run_run_command(const io::RunConfig& config, const std::string& out_dir);
 
-}  // namespace pednav::io
+}  // namespace pednav::pipeline

@@ -1,0 +1,249 @@
+// The engine's filter: the nominal INS state with the differential receiver clocks, and the covariance of its error
+// state. Propagation (Φ, Q_d at the mechanization rate, clocks and multipath Gauss-Markov slots), the Joseph-form
+// update with closed-loop feedback, restarts of single states (clock jumps, multipath slots), the health check, the
+// errors-in-variables compensation of the scale-factor updates (docs/consistency.md §3.6), and the smoother's
+// bookkeeping of every step (docs/fusion.md §12). Which measurement rows exist is not its business: fusion/
+// gnss_update, fusion/stance_updates build them. Internal to the engine (fusion/engine.hpp is the public API).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/column_sparse.hpp"
+#include "fusion/engine.hpp"
+#include "fusion/kalman.hpp"
+#include "fusion/rts.hpp"
+#include "gnss/types.hpp"
+#include "ins/error_state.hpp"
+#include "ins/imu.hpp"
+#include "ins/nav_state.hpp"
+
+namespace pednav::fusion {
+
+/// Three rows over the error state (fixed capacity: no heap allocation in the update loop).
+using Rows3 = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor, 3, ins::kMaxErrorDim>;
+
+/// The IMU spec as the filter models it: with EngineOptions::bias_random_walk the Gauss-Markov bias part becomes a
+/// random walk of the same PSD (docs/error_state.md eq. 3.4-3.5).
+ins::ImuSpec filter_spec(const EngineOptions& o);
+
+// The filter state: nominal INS state + differential clocks, error covariance. Matrices have a fixed capacity
+// (ins::ErrorMatrix): nothing here allocates on the heap per step (docs/performance.md).
+class ErrorStateFilter {
+ public:
+  ErrorStateFilter(const EngineOptions& o, int n_clocks);
+
+  /// Why the filter cannot run (e.g. more states than ins::kMaxErrorDim), empty if it can.
+  const std::string& problem() const { return problem_; }
+
+  void init(const ins::NavState& nav, const ins::ImuErrors& imu, double sigma_yaw_rad);
+
+  // Replace the variance of a 3-state block (position [m], velocity [m/s]) by sigma² per axis, uncorrelated
+  // (re-initialization).
+  void set_block_sigma(const ins::Block& b, double sigma);
+
+  // Mechanize one (already bias-corrected) increment and propagate the covariance.
+  void predict(const ins::ImuIncrement& inc);
+
+  /// The error a reconstructed saturated run leaves (variance [rad²] of a gyro run's angle or [m²/s²] of an
+  /// accelerometer run's velocity, about/along body axis `axis`): process noise of the next prediction.
+  void add_saturation_noise(bool gyro, int axis, double variance) {
+    (gyro ? sat_att_var_b_ : sat_vel_var_b_)(axis) += variance;
+    saturation_noise_ = true;
+  }
+
+  // Joseph-form update with residuals r (measured - predicted), Jacobian H and noise covariance R;
+  // the correction is fed back into the nominal state (closed loop) and the error state reset to zero.
+  template <typename MatH, typename VecR, typename MatR>
+  bool update(const VecR& r, const MatH& H, const MatR& R) {
+    ErrorVector dx;
+    // Smoother: the estimate of the error at the last output epoch, its variance and its cross-covariance with the
+    // current error are conditioned on the same measurement, with the filter's S and K (docs/fusion.md eqs.
+    // 12.16-12.17).
+    // Errors-in-variables compensation (docs/consistency.md eq. E.4): the mean noise part of each scale correction.
+    double eiv_bias[kMaxEivTerms];
+    const bool ok = joseph_update(P_, H, r, R, dx, [&](const auto& S_ldlt, const auto& K) {
+      if (recording_ && !shadow_) interval_.update(H, r, S_ldlt, K);
+      eiv_update_all(eiv_, H, S_ldlt, K, eiv_bias);
+    }, consider_);
+    if (!ok) return false;
+    if (shadow_) {
+      // The smoother's Kalman-gain filter (docs/fusion.md eq. 12.23) conditions its mean η of the error on the same
+      // residual, ν = r − H η; the smoother's interval uses its S and gain.
+      VecR nu = r;
+      nu.noalias() -= H * eta_;
+      // Its gain has the same errors-in-variables mean as the filter's (docs/consistency.md eq. E.4), from its own
+      // footprints; without the subtraction η's scale part drifts by it at every update.
+      ErrorVector dxo;
+      double eivo_bias[kMaxEivTerms];
+      if (joseph_update(Po_, H, nu, R, dxo, [&](const auto& So_ldlt, const auto& Ko) {
+            if (recording_) interval_.update(H, nu, So_ldlt, Ko);
+            eiv_update_all(eivo_, H, So_ldlt, Ko, eivo_bias);
+          })) {
+        eiv_subtract(eivo_, eivo_bias, dxo, recording_, Po_);
+        eta_ += dxo;
+      }
+    }
+    // The smoother's interval conditions on the forward filter's residual unless the Kalman-gain filter runs (then η
+    // carries the subtraction, eq. 12.23).
+    eiv_subtract(eiv_, eiv_bias, dx, recording_ && !shadow_, P_);
+    apply(dx);
+    if (shadow_) eta_ -= dx;  // the nominal moved by dx: the error's conditional mean moves by −dx (eq. 12.23)
+    return true;
+  }
+
+  void apply(const ErrorVector& dx);
+
+  /// The multipath state of satellite `sat` measured at rover epoch t_ns [GPST ns]: its slot, or (satellite new, or
+  /// not measured for longer than multipath_reset_gap_s) a slot restarted as a fresh unit-variance state — the
+  /// least recently used slot not yet used at this epoch. `reset` tells whether it was restarted. -1 when every slot
+  /// is in use at this epoch (that satellite's code is then treated as white, docs/consistency.md §3).
+  int multipath_slot(const gnss::SatId& sat, int64_t t_ns, bool& reset);
+  /// First state of the g-sensitivity block (column-major G_g), −1 without it.
+  int g_sensitivity_offset() const { return g_sens_offset_; }
+  /// State index of multipath slot `slot`; its nominal value u (closed loop: normally 0 after each update, decayed).
+  int multipath_index(int slot) const { return mp_block_.offset + slot; }
+  double multipath_value(int slot) const { return mp_value_[slot]; }
+  bool has_multipath() const { return mp_block_.dim > 0; }
+
+  // P <- J P J^T with J = I except the (velocity, attitude) block = A (docs/fusion.md eq. 5.9).
+  void reexpress_velocity_attitude(const Eigen::Matrix3d& A);
+  static void reexpress_velocity_attitude(const Eigen::Matrix3d& A, ErrorMatrix& P_);
+
+  // State i restarted as a fresh variable of the given variance, independent of everything before (clock, drift,
+  // multipath slot): in P, in the smoother's Kalman-gain filter and in the smoother's interval (eq. 12.19).
+  void restart_variable(int i, double variance);
+
+  // Reset a clock to a new value with a large variance (receiver clock jump).
+  void reset_clock(int slot, double value_m, double sigma_m);
+  void reset_drift(double value_mps, double sigma_mps);
+
+  /// Start a smoother interval at the current step (an output epoch, after all its updates; docs/fusion.md eq.
+  /// 12.14); from here on every prediction, update, re-expression and reset is also applied to the interval.
+  void smoother_restart();
+  /// The backward record of the interval from the last smoother_restart() to the current step (eq. 12.20; with
+  /// consider states eq. 12.24).
+  void smoother_close(RtsSegment& out) const;
+  /// Var and conditional mean of the error at the current step as the smoother sees them: the filter's P and 0, or
+  /// with consider states the Kalman-gain filter's P_o and η (docs/fusion.md §12.6).
+  const ErrorMatrix& smoother_P() const { return shadow_ ? Po_ : P_; }
+  ErrorVector smoother_mean() const { return shadow_ ? eta_ : ErrorVector::Zero(P_.rows()); }
+  /// Stop the smoother's bookkeeping (a re-initialization: the backward pass cannot cross it).
+  void smoother_stop() { recording_ = false; }
+
+  // check_covariance: also the symmetry / positive semi-definiteness test (an LDLT: done at the output epochs only).
+  bool healthy(std::string& why, bool check_covariance) const;
+
+  /// The IMU errors of the nominal state, their σ and the compensation totals (summary.json `imu_estimate`).
+  ImuEstimate imu_estimate() const;
+
+  /// Sum of the errors-in-variables corrections subtracted from scale state `state` so far (docs/consistency.md §3.6).
+  double eiv_correction(int state) const;
+
+  const ins::ErrorStateLayout& layout() const { return layout_; }
+  ins::InsState& x() { return x_; }
+  const ins::InsState& x() const { return x_; }
+  const ErrorMatrix& P() const { return P_; }
+  double clock(int slot) const { return clock_m_[slot]; }
+  double drift() const { return drift_mps_; }
+  int clock_offset(int slot) const { return clock_blocks_[slot].offset; }
+  int drift_offset() const { return drift_block_.offset; }
+
+ private:
+  const EngineOptions& o_;
+  const ins::ImuSpec spec_;  // the IMU error model the filter uses (filter_spec)
+  ins::ErrorStateLayout layout_;
+  std::string problem_;
+  std::vector<ins::Block> clock_blocks_;
+  ins::Block drift_block_{0, 0};
+  ins::InsState x_;
+  ins::DiscreteErrorModel model_;  // Φ, Q_d of the current step (reused: no per-step construction)
+  Eigen::Vector3d sat_att_var_b_ = Eigen::Vector3d::Zero();  // pending saturation noise (add_saturation_noise), body axes
+  Eigen::Vector3d sat_vel_var_b_ = Eigen::Vector3d::Zero();
+  bool saturation_noise_ = false;
+  ErrorMatrix P_;
+  ErrorMatrix tmp_;
+  std::vector<double> clock_m_;
+  double drift_mps_ = 0.0;
+  // Code multipath Gauss-Markov states (docs/consistency.md §3): block, nominal values, satellite and last epoch.
+  static constexpr int64_t kNeverNs = std::numeric_limits<int64_t>::min();
+  ins::Block mp_block_{0, 0};
+  int g_sens_offset_ = -1;  // g-sensitivity block (docs/error_state.md §5), −1 without it
+  ConsiderStates consider_;  // states the updates never correct (Schmidt–Kalman): the g-sensitivity block
+  std::vector<double> mp_value_;
+  std::vector<gnss::SatId> mp_sat_;
+  std::vector<int64_t> mp_last_ns_;
+  ColumnSparse<ins::kMaxErrorDim> Phi_sparse_;
+  // Errors-in-variables compensation of the scale-factor estimates (docs/consistency.md §3.6). The scale column of
+  // Φ is built from the measured increment, whose white noise ν also drives the error state: the noise part of
+  // P's column of scale state s and the noise part of the error are both Σ_k g_k ν_k (times P_ss), so every update
+  // moves ŝ by E[K_s r] = tr(S⁻¹ H M Hᵀ) on average, M = Σ_k P_ss σ_ν² g_k g_kᵀ (eq. E.4). M propagates like a
+  // covariance (Φ M Φᵀ + input, (I − K H) M (I − K H)ᵀ at updates) and that mean is subtracted.
+  static constexpr int kMaxEivTerms = 6;
+  struct EivTerm {
+    int state;         // scale state index
+    int block_offset;  // error block the sensor noise enters: attitude (gyro) or velocity (accelerometer)
+    int axis;          // body axis
+    bool gyro;
+    ErrorMatrix M;
+    double total = 0.0;
+  };
+  std::vector<EivTerm> eiv_;
+  std::vector<EivTerm> eivo_;  // the same for the smoother's Kalman-gain filter (consider states, docs/fusion.md §12.6)
+  ErrorMatrix eiv_tmp_, eiv_zero_;
+  int eiv_dim_ = 0;
+  ColumnSparse<ins::kMaxErrorDim> eiv_Phi_;
+
+  void eiv_predict(double dt, const ins::NavState& before, const ins::NavState& after, std::vector<EivTerm>& terms,
+                   const ErrorMatrix& P);
+
+  // eiv_update for every term of `terms` (the forward filter's or the smoother's Kalman-gain filter's) into bias[].
+  template <typename MatH, typename Ldlt, typename MatK>
+  void eiv_update_all(std::vector<EivTerm>& terms, const MatH& H, const Ldlt& S_ldlt, const MatK& K, double* bias) {
+    if (terms.empty()) return;
+    int nz[ins::kMaxErrorDim];
+    const int n_nz = nonzero_columns(H, nz);
+    for (size_t j = 0; j < terms.size(); ++j) bias[j] = eiv_update(terms[j].M, H, nz, n_nz, S_ldlt, K);
+  }
+  // Subtract the mean noise parts from the correction dx (docs/consistency.md eq. E.4) and, with shift_interval,
+  // remove the same bias from the smoother interval's mean: in every component by regression on the scale states
+  // (eq. E.7; P: the covariance after the update of the filter whose residual the interval conditions on), or in
+  // the scale rows only (eq. E.6) — without either, its scale estimate at the interval's start would take the
+  // subtraction back.
+  void eiv_subtract(std::vector<EivTerm>& terms, const double* bias, ErrorVector& dx, bool shift_interval,
+                    const ErrorMatrix& P);
+
+  // The mean noise-noise part of K_s r for one scale state, tr(S⁻¹ H M Hᵀ), and M ← (I − K H) M (I − K H)ᵀ. H of a
+  // ZUPT or GNSS epoch touches a few states only: M Hᵀ is summed over H's non-zero columns nz[0..n_nz).
+  template <typename MatH, typename Ldlt, typename MatK>
+  double eiv_update(ErrorMatrix& M, const MatH& H, const int* nz, int n_nz, const Ldlt& S_ldlt, const MatK& K) {
+    const int ne = static_cast<int>(M.rows());
+    if (ne > H.cols()) return 0.0;
+    using UMat = Eigen::Matrix<double, Eigen::Dynamic, MatH::RowsAtCompileTime, Eigen::ColMajor, ins::kMaxErrorDim,
+                               MatH::MaxRowsAtCompileTime>;
+    using SMat = Eigen::Matrix<double, MatH::RowsAtCompileTime, MatH::RowsAtCompileTime, Eigen::ColMajor,
+                               MatH::MaxRowsAtCompileTime, MatH::MaxRowsAtCompileTime>;
+    UMat U;  // M Hᵀ
+    U.setZero(ne, H.rows());
+    for (int k = 0; k < n_nz && nz[k] < ne; ++k) U.noalias() += M.col(nz[k]) * H.col(nz[k]).head(ne).transpose();
+    SMat B;  // H M Hᵀ
+    B.noalias() = H.leftCols(ne) * U;
+    const double bias = S_ldlt.solve(B).trace();
+    // (I − K H) M (I − K H)ᵀ on the INS block: the noise-free form (R = 0) of the Joseph update.
+    gain_downdate(M, U, K.topRows(ne), B);
+    return bias;
+  }
+  // Smoother: the interval since the last output epoch (docs/fusion.md eqs. 12.14-12.20), kept from the first
+  // output epoch on.
+  bool recording_ = false;
+  RtsInterval interval_;
+  // With consider states: the Kalman-gain filter of the same linearization that the smoother runs on (docs/fusion.md
+  // §12.6): its covariance P_o = Var(δx | Y) and the conditional mean η = E[δx | Y] of the forward filter's error.
+  bool shadow_ = false;
+  ErrorMatrix Po_;
+  ErrorVector eta_, eta_tmp_;
+};
+}  // namespace pednav::fusion

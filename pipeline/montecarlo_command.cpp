@@ -1,0 +1,423 @@
+// `pednav montecarlo` (pipeline/montecarlo_command.hpp).
+#include "pipeline/montecarlo_command.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "core/geodesy.hpp"
+#include "core/rotation.hpp"
+#include "eval/montecarlo.hpp"
+#include "fusion/engine.hpp"
+#include "io/atomic_file.hpp"
+#include "io/config.hpp"
+#include "io/log.hpp"
+#include "io/plot.hpp"
+#include "io/plot_figures.hpp"
+#include "io/scenario_config.hpp"
+#include "pipeline/run_command.hpp"
+#include "pipeline/simulate_command.hpp"
+#include "sim/gnss_sim.hpp"
+#include "sim/simulator.hpp"
+
+namespace pednav::pipeline {
+namespace {
+
+// Mode ins starts every run from the true position and heading; its P says so (1 cm, 0.1°: small, not zero).
+constexpr double kTrueStartSigmaPosM = 0.01;
+constexpr double kTrueStartSigmaYawRad = 0.1 * 3.14159265358979323846 / 180.0;
+
+
+// One finished run (what runs.csv shows), with its per-epoch errors.
+struct RunRecord {
+  int index = 0;
+  uint64_t seed = 0;
+  bool ok = false;
+  std::string message;
+  double wall_s = 0.0;
+  double distance_m = 0.0;
+  eval::McRun run;
+};
+
+std::string run_file(const std::string& out, int i) {
+  char b[32];
+  std::snprintf(b, sizeof b, "run_%04d.csv", i);
+  return (std::filesystem::path(out) / "runs" / b).string();
+}
+
+double yaw_n(const ins::NavState& x) {
+  const Geodetic llh = geodetic_from_ecef(x.p_eb_e);
+  return euler_from_R_n_b(R_e_n(llh.lat, llh.lon).transpose() * x.R_e_b()).z();
+}
+
+// Errors of one solution against the simulation truth (at the IMU rate, GPST on the sample grid).
+std::vector<eval::McEpoch> errors(const sim::Simulation& s, const std::vector<fusion::EpochOutput>& sol) {
+  std::vector<eval::McEpoch> out;
+  const auto& nav = s.truth.nav;
+  const double rate = s.scenario.imu.rate_hz;
+  for (const auto& e : sol) {
+    const long i = std::lround((e.t - nav.front().t) * rate);
+    if (i < 0 || i >= static_cast<long>(nav.size()) || std::abs(nav[i].t - e.t) > 1e-6) continue;
+    eval::McEpoch m;
+    m.t_s = e.t - s.scenario.start;
+    m.distance_m = i < static_cast<long>(s.antenna.size()) ? s.antenna[i].route_m : 0.0;
+    const Eigen::Vector3d enu = enu_from_ecef(e.nav.p_eb_e, nav[i].p_eb_e);
+    m.err_ned_m = Eigen::Vector3d(enu.y(), enu.x(), -enu.z());
+    m.cov_ned_m2 = e.cov_p_n;
+    m.err_yaw_rad = wrap_pi(yaw_n(e.nav) - yaw_n(nav[i]));
+    m.var_yaw_rad2 = e.sd_yaw_rad * e.sd_yaw_rad;
+    out.push_back(m);
+  }
+  return out;
+}
+
+// Simulate and run one seed (thread-safe: in-memory simulation and engine, no RTKLIB).
+RunRecord run_one(const io::ScenarioFile& file, const MontecarloArgs& mo, int index) {
+  RunRecord r;
+  r.index = index;
+  const auto t0 = std::chrono::steady_clock::now();
+  sim::Scenario sc = file.scenario;
+  sc.seed = file.scenario.seed + mo.seed_offset + static_cast<uint64_t>(index);
+  r.seed = sc.seed;
+  auto s = sim::simulate(sc);
+  if (!s) {
+    r.message = s.error().message;
+    return r;
+  }
+  const std::string mode = !mo.mode.empty() ? mo.mode : (s->has_gnss ? "tc" : "ins");
+  io::RunConfig c;  // `pednav run` defaults, as in the configuration `pednav simulate` writes
+  c.mode = mode;
+  c.imu.spec = sc.imu.spec;
+  c.zupt.form = mo.zupt_form;
+  c.smoother_enabled = mo.smoother;
+  if (mo.no_scale_states) c.scale_factors.states = false;
+  if (mo.gauss_markov_bias) c.bias.model = "gauss_markov";
+  // The simulated sensors' own models where the flags ask for them (what config_datasheet.yaml of pednav simulate
+  // has): receiver weights (docs/consistency.md §3.8), walker lever arm (docs/fusion.md §14), the gyro's
+  // g-sensitivity σ (its 9 consider states, docs/error_state.md §5), code multipath σ/τ (docs/consistency.md §3).
+  pipeline::DataSheetParts parts;
+  parts.receiver_weights = mo.receiver_weights;
+  parts.lever_arm = mo.scenario_lever_arm;
+  parts.g_sensitivity = mo.g_sensitivity_states;
+  parts.multipath = mo.multipath_states;
+  pipeline::apply_data_sheet(sc, parts, c);
+  if (!std::isnan(mo.elevation_weight)) c.gnss.elevation_weight = mo.elevation_weight;
+  if (mo.scale_bias_compensation) c.scale_factors.bias_compensation = *mo.scale_bias_compensation;
+  fusion::EngineOptions o = pipeline::engine_options(c);
+  if (mo.smoother_eiv_regression) o.smoother_eiv_regression = *mo.smoother_eiv_regression;
+  if (mo.scale_states || mo.accel_scale_states) o.estimate_scale_factors = true;
+  if (mo.scale_states) o.estimate_gyro_scale_factors = true;  // both blocks (the tc default)
+  if (mo.accel_scale_states) o.estimate_gyro_scale_factors = false;
+  if (mo.bias_random_walk) o.bias_random_walk = true;
+  o.repair_saturation = mo.saturation_repair;
+  if (mo.no_doppler) o.use_doppler = false;
+  if (mo.foot_antenna_velocity) o.antenna_velocity_model = fusion::AntennaVelocityModel::kFoot;
+  if (mo.white_code) o.multipath_sigma_m = 0.0;
+  o.zupt_updates = mo.zupt_updates;
+  o.step_velocity.enabled = mo.step_velocity;
+  o.step_velocity.leg_length_m = mo.leg_length_m;
+  fusion::EngineInputs in;
+  in.imu = &s->imu;
+  if (mode == "tc") {
+    if (!s->has_gnss) {
+      r.message = "mode tc needs a scenario with gnss.enabled";
+      return r;
+    }
+    o.base_position_e = s->gnss.p_base_e;
+    in.nav = &s->nav;
+    in.rover = &s->gnss.rover.epochs;
+    in.base = &s->gnss.base.epochs;
+  } else {
+    // INS/ZUPT only: start from the true position and heading (seed 000: errors relative to a known start).
+    const ins::NavState& t0n = s->truth.nav.front();
+    o.initial_position_e = t0n.p_eb_e;
+    o.initial_yaw_rad = yaw_n(t0n);
+    // ... and say so in P: the configured 5 m / 10° are for a typed-in start, and would make every σ ratio and
+    // NEES of an ins run measure the initial uncertainty instead of the drift (docs/consistency.md §1).
+    o.initial_sigma_pos_m = kTrueStartSigmaPosM;
+    o.initial_sigma_yaw_rad = kTrueStartSigmaYawRad;
+  }
+  auto res = fusion::run_forward(in, o);
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!res) {
+    r.message = res.error().message;
+    return r;
+  }
+  r.ok = true;
+  r.distance_m = s->antenna.empty() ? 0.0 : s->antenna.back().route_m;
+  r.run.forward = errors(*s, res->epochs);
+  r.run.smoothed = errors(*s, res->smoothed);
+  return r;
+}
+
+// Per-run file: a '#' header line with the run facts, then one row per epoch and solution.
+constexpr const char* kRunHeader =
+    "solution,t_s,distance_m,err_n_m,err_e_m,err_d_m,cov_nn_m2,cov_ne_m2,cov_nd_m2,cov_ee_m2,cov_ed_m2,cov_dd_m2,"
+    "err_yaw_rad,var_yaw_rad2";
+
+Expected<void> write_run(const std::string& path, const RunRecord& r) {
+  std::ostringstream o;
+  o.precision(10);
+  std::string msg = r.message;
+  std::replace(msg.begin(), msg.end(), '\n', ' ');
+  o << "# index=" << r.index << " seed=" << r.seed << " ok=" << r.ok << " wall_s=" << r.wall_s
+    << " distance_m=" << r.distance_m << " message=" << msg << "\n" << kRunHeader << "\n";
+  for (int k = 0; k < 2; ++k) {
+    for (const auto& e : k == 0 ? r.run.forward : r.run.smoothed) {
+      const auto& C = e.cov_ned_m2;
+      o << (k == 0 ? "forward" : "smoothed") << ',' << e.t_s << ',' << e.distance_m << ',' << e.err_ned_m.x() << ','
+        << e.err_ned_m.y() << ',' << e.err_ned_m.z() << ',' << C(0, 0) << ',' << C(0, 1) << ',' << C(0, 2) << ','
+        << C(1, 1) << ',' << C(1, 2) << ',' << C(2, 2) << ',' << e.err_yaw_rad << ',' << e.var_yaw_rad2 << '\n';
+    }
+  }
+  return io::write_file_atomic(path, o.str());
+}
+
+Expected<RunRecord> read_run(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  if (!std::getline(in, line) || line.rfind("# index=", 0) != 0) return make_error(path + ":1: expected '# index=...'");
+  RunRecord r;
+  auto field = [&](const std::string& key) {
+    const auto p = line.find(" " + key + "=");
+    if (p == std::string::npos) return std::string();
+    const auto b = p + key.size() + 2;
+    const auto e = key == "message" ? std::string::npos : line.find(' ', b);
+    return line.substr(b, e == std::string::npos ? std::string::npos : e - b);
+  };
+  r.index = std::atoi(line.substr(8).c_str());
+  r.seed = std::strtoull(field("seed").c_str(), nullptr, 10);
+  r.ok = field("ok") == "1";
+  r.wall_s = std::atof(field("wall_s").c_str());
+  r.distance_m = std::atof(field("distance_m").c_str());
+  r.message = field("message");
+  std::getline(in, line);  // column header
+  long row = 2;
+  while (std::getline(in, line)) {
+    ++row;
+    std::stringstream ss(line);
+    std::string sol, cell;
+    std::getline(ss, sol, ',');
+    std::vector<double> v;
+    while (std::getline(ss, cell, ',')) v.push_back(std::atof(cell.c_str()));
+    if (v.size() != 13 || (sol != "forward" && sol != "smoothed")) {
+      return make_error(path + ":" + std::to_string(row) + ": expected 14 columns (" + kRunHeader + ")");
+    }
+    eval::McEpoch e;
+    e.t_s = v[0];
+    e.distance_m = v[1];
+    e.err_ned_m = Eigen::Vector3d(v[2], v[3], v[4]);
+    e.cov_ned_m2 << v[5], v[6], v[7], v[6], v[8], v[9], v[7], v[9], v[10];
+    e.err_yaw_rad = v[11];
+    e.var_yaw_rad2 = v[12];
+    (sol == "forward" ? r.run.forward : r.run.smoothed).push_back(e);
+  }
+  return r;
+}
+
+double horizontal_rms(const std::vector<eval::McEpoch>& ep) {
+  if (ep.empty()) return std::nan("");
+  double s = 0;
+  for (const auto& e : ep) s += e.err_ned_m.head<2>().squaredNorm();
+  return std::sqrt(s / static_cast<double>(ep.size()));
+}
+
+nlohmann::json summary_json(const eval::McSummary& m) {
+  return {{"epochs", m.epochs},
+          {"nees_in_band_fraction", m.nees_in_band_fraction},
+          {"nees_above_band_fraction", m.nees_above_band_fraction},
+          {"nees_below_band_fraction", m.nees_below_band_fraction},
+          {"nees_yaw_in_band_fraction", m.nees_yaw_in_band_fraction},
+          {"mean_nees_horizontal", m.mean_nees_horizontal},
+          {"sigma_ratio_horizontal", m.sigma_ratio_horizontal},
+          {"sigma_ratio_yaw", m.sigma_ratio_yaw},
+          {"sigma_ratio_horizontal_pooled", m.sigma_ratio_horizontal_pooled},
+          {"sigma_ratio_yaw_pooled", m.sigma_ratio_yaw_pooled},
+          {"inside_3sigma_fraction", m.inside_3sigma_fraction},
+          {"rms_horizontal_m", m.rms_horizontal_m}};
+}
+
+void nees_rows(std::ostringstream& o, const char* sol, const std::vector<eval::McEpochStats>& st) {
+  for (const auto& e : st) {
+    o << sol << ',' << e.t_s << ',' << e.runs << ',' << e.distance_m;
+    for (int i = 0; i < 3; ++i) o << ',' << e.mean_err_ned_m(i);
+    for (int i = 0; i < 3; ++i) o << ',' << e.sample_sd_ned_m(i);
+    for (int i = 0; i < 3; ++i) o << ',' << e.filter_sd_ned_m(i);
+    o << ',' << e.mean_err_yaw_rad * kRadToDeg << ',' << e.sample_sd_yaw_rad * kRadToDeg << ','
+      << e.filter_sd_yaw_rad * kRadToDeg << ',' << e.rms_horizontal_m << ',' << e.nees_horizontal << ','
+      << e.nees_lo_2dof << ',' << e.nees_hi_2dof << ',' << e.nees_yaw << ',' << e.nees_lo_1dof << ','
+      << e.nees_hi_1dof << ',' << e.inside_3sigma_fraction << '\n';
+  }
+}
+
+}  // namespace
+
+Expected<void> run_montecarlo_command(const MontecarloArgs& mo) {
+  const auto t_start = std::chrono::steady_clock::now();
+  auto file = io::load_scenario(mo.scenario_path);
+  if (!file) return file.error();
+  std::error_code ec;
+  std::filesystem::create_directories(std::filesystem::path(mo.out_dir) / "runs", ec);
+  if (ec) return make_error(fmt::format("{}: cannot create the output folder: {}", mo.out_dir, ec.message()));
+  // Resume: runs whose file exists are read, not redone.
+  std::vector<RunRecord> records(mo.runs);
+  std::vector<int> todo;
+  for (int i = 0; i < mo.runs; ++i) {
+    const std::string p = run_file(mo.out_dir, i);
+    if (std::filesystem::exists(p)) {
+      auto r = read_run(p);
+      if (!r) return make_error(r.error().message + " (delete it to redo that run)");
+      records[i] = std::move(*r);
+    } else {
+      todo.push_back(i);
+    }
+  }
+  if (todo.size() < static_cast<size_t>(mo.runs)) {
+    spdlog::info("montecarlo: {} of {} runs already done in {}, {} to run", mo.runs - todo.size(), mo.runs,
+                 mo.out_dir, todo.size());
+  }
+  const int jobs = std::max(1, mo.jobs > 0 ? mo.jobs : static_cast<int>(std::thread::hardware_concurrency()));
+  std::atomic<size_t> next{0};
+  std::mutex mu;
+  std::string write_error;
+  io::Progress progress("montecarlo", static_cast<int64_t>(todo.size()), io::progress_enabled());
+  int64_t done = 0;
+  auto worker = [&] {
+    for (;;) {
+      const size_t k = next++;
+      if (k >= todo.size()) return;
+      RunRecord r = run_one(*file, mo, todo[k]);
+      const auto w = write_run(run_file(mo.out_dir, r.index), r);
+      std::lock_guard<std::mutex> lock(mu);
+      if (!w && write_error.empty()) write_error = w.error().message;
+      records[r.index] = std::move(r);
+      progress.update(++done);
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int j = 0; j < std::min<int>(jobs, static_cast<int>(todo.size())); ++j) threads.emplace_back(worker);
+  for (auto& t : threads) t.join();
+  progress.finish();
+  if (!write_error.empty()) return make_error(write_error);
+
+  // runs.csv
+  std::vector<eval::McRun> ok_runs;
+  std::ostringstream rc;
+  rc.precision(8);
+  rc << "run,seed,ok,wall_s,distance_m,epochs,forward_rms_horizontal_m,smoothed_rms_horizontal_m,"
+        "forward_final_horizontal_m,message\n";
+  double run_wall_sum = 0;
+  for (const auto& r : records) {
+    run_wall_sum += r.wall_s;
+    const auto& f = r.run.forward;
+    std::string msg = r.message;
+    std::replace(msg.begin(), msg.end(), ',', ';');
+    rc << r.index << ',' << r.seed << ',' << r.ok << ',' << r.wall_s << ',' << r.distance_m << ',' << f.size() << ','
+       << horizontal_rms(f) << ',' << horizontal_rms(r.run.smoothed) << ','
+       << (f.empty() ? std::nan("") : f.back().err_ned_m.head<2>().norm()) << ",\"" << msg << "\"\n";
+    if (r.ok) ok_runs.push_back(r.run);
+    else spdlog::warn("montecarlo: run {} (seed {}) failed: {}", r.index, r.seed, r.message);
+  }
+  if (ok_runs.size() < 2) {
+    return make_error(fmt::format("montecarlo: {} successful runs; at least 2 are needed for statistics", ok_runs.size()));
+  }
+  const int n_ok = static_cast<int>(ok_runs.size());
+  // Epochs present in at least 90 % of the successful runs (start/end epochs differ slightly between seeds).
+  const int min_runs = std::max(2, static_cast<int>(std::ceil(0.9 * n_ok)));
+  const auto fwd = eval::aggregate_epochs(ok_runs, false, min_runs);
+  const auto smo = eval::aggregate_epochs(ok_runs, true, min_runs);
+  std::ostringstream nc;
+  nc.precision(8);
+  nc << "solution,t_s,runs,distance_m,mean_err_n_m,mean_err_e_m,mean_err_d_m,sample_sd_n_m,sample_sd_e_m,"
+        "sample_sd_d_m,filter_sd_n_m,filter_sd_e_m,filter_sd_d_m,mean_err_yaw_deg,sample_sd_yaw_deg,filter_sd_yaw_deg,"
+        "rms_horizontal_m,nees_horizontal,nees_lo_2dof,nees_hi_2dof,nees_yaw,nees_lo_1dof,nees_hi_1dof,"
+        "inside_3sigma_fraction\n";
+  nees_rows(nc, "forward", fwd);
+  nees_rows(nc, "smoothed", smo);
+  const eval::McSummary sf = eval::summarize(fwd, n_ok, mo.summary_from_s);
+  const eval::McSummary ss = eval::summarize(smo, n_ok, mo.summary_from_s);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  nlohmann::json j;
+  j["scenario"] = file->scenario.name;
+  j["runs"] = n_ok;
+  j["runs_requested"] = mo.runs;
+  j["runs_failed"] = mo.runs - n_ok;
+  j["runs_done_now"] = todo.size();
+  j["jobs"] = jobs;
+  j["nees_in_band_fraction_forward"] = sf.nees_in_band_fraction;
+  // No smoothed epochs (--no-smoother, or a re-initialized run): null, not 0.
+  const bool have_smoothed = ss.epochs > 0;
+  auto smoothed_value = [&](double v) { return have_smoothed ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  j["nees_in_band_fraction_smoothed"] = smoothed_value(ss.nees_in_band_fraction);
+  j["sigma_ratio_horizontal"] = sf.sigma_ratio_horizontal;
+  j["sigma_ratio_yaw"] = sf.sigma_ratio_yaw;
+  j["sigma_ratio_horizontal_smoothed"] = smoothed_value(ss.sigma_ratio_horizontal);
+  j["sigma_ratio_yaw_smoothed"] = smoothed_value(ss.sigma_ratio_yaw);
+  j["wall_s"] = wall;
+  j["run_wall_s_sum"] = run_wall_sum;
+  j["nees_band_probability"] = 0.95;
+  j["min_runs_per_epoch"] = min_runs;
+  j["forward"] = summary_json(sf);
+  j["smoothed"] = have_smoothed ? summary_json(ss) : nlohmann::json(nullptr);
+  // The band test by time window (docs/consistency.md §1, §3.13): where the in-band share is lost.
+  auto windows_json = [&](const std::vector<eval::McEpochStats>& ep) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const eval::McWindowBand& w : eval::window_bands(ep, mo.window_s)) {
+      a.push_back({{"from_s", w.from_s}, {"to_s", w.to_s}, {"epochs", w.epochs},
+                   {"nees_in_band_fraction", w.nees_in_band_fraction},
+                   {"mean_nees_horizontal", w.mean_nees_horizontal}});
+    }
+    return a;
+  };
+  j["window_s"] = mo.window_s;
+  j["windows_forward"] = windows_json(fwd);
+  j["windows_smoothed"] = have_smoothed ? windows_json(smo) : nlohmann::json(nullptr);
+  for (const auto& [name, text] : {std::pair<std::string, std::string>{"runs.csv", rc.str()},
+                                   {"nees.csv", nc.str()},
+                                   {"summary.json", j.dump(2) + "\n"}}) {
+    if (auto w = io::write_file_atomic((std::filesystem::path(mo.out_dir) / name).string(), text); !w) return w.error();
+  }
+  if (mo.plots) {  // seed 000 Figs. 4-6 (gnuplot; a missing gnuplot costs the figures, not the run)
+    const std::string what = fmt::format("{}, {} runs", file->scenario.name, n_ok);
+    const std::vector<eval::McEpochStats> none;
+    const auto& smo_or_none = have_smoothed ? smo : none;
+    for (const auto& [name, spec] : std::vector<std::pair<std::string, io::PlotSpec>>{
+             {"nees.svg",
+              io::montecarlo_nees_plot(fmt::format("{}: average horizontal NEES (in band: forward {:.1f} %{})", what,
+                                                   100.0 * sf.nees_in_band_fraction,
+                                                   have_smoothed ? fmt::format(", smoothed {:.1f} %",
+                                                                               100.0 * ss.nees_in_band_fraction)
+                                                                 : std::string()),
+                                       fwd, smo_or_none)},
+             {"sigma.svg", io::montecarlo_sigma_plot(what + ": forward position sigma, sample vs filter", fwd, false)},
+             {"sigma_yaw.svg", io::montecarlo_sigma_plot(what + ": forward yaw sigma, sample vs filter", fwd, true)},
+             {"error_vs_distance.svg",
+              io::montecarlo_distance_plot(what + ": RMS horizontal error vs distance", fwd, smo_or_none)}}) {
+      if (auto w = io::write_plot_svg((std::filesystem::path(mo.out_dir) / name).string(), spec); !w) {
+        spdlog::warn("montecarlo: {} not written: {}", name, w.error().message);
+      }
+    }
+  }
+  const std::string smoothed_text =
+      have_smoothed ? fmt::format("NEES in band {:.1f} %, sigma ratio horizontal {:.3f} yaw {:.3f}, RMS {:.2f} m",
+                                  100.0 * ss.nees_in_band_fraction, ss.sigma_ratio_horizontal, ss.sigma_ratio_yaw,
+                                  ss.rms_horizontal_m)
+                    : std::string("none");
+  spdlog::info("montecarlo: {} runs ({} failed) in {:.1f} s on {} threads; forward: NEES in band {:.1f} % of {} "
+               "epochs, sigma ratio horizontal {:.3f} yaw {:.3f}, RMS {:.2f} m; smoothed: {} -> {}",
+               n_ok, mo.runs - n_ok, wall, jobs, 100.0 * sf.nees_in_band_fraction, sf.epochs,
+               sf.sigma_ratio_horizontal, sf.sigma_ratio_yaw, sf.rms_horizontal_m, smoothed_text, mo.out_dir);
+  return {};
+}
+
+}  // namespace pednav::pipeline
