@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   pednav::apps::add_gnss_command(app, action);
   pednav::apps::add_simulate_command(app, action);
   pednav::apps::add_run_command(app, action);
+  pednav::apps::add_calibrate_command(app, action);
   pednav::apps::add_montecarlo_command(app, action);
   pednav::apps::add_outage_command(app, action);
   pednav::apps::add_report_command(app, action);

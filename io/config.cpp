@@ -115,7 +115,9 @@ std::string to_yaml(const RunConfig& c) {
   if (!c.imu.file.empty()) {
     e << YAML::Key << "imu" << YAML::Value << YAML::BeginMap << YAML::Key << "file" << YAML::Value << c.imu.file;
     if (!c.imu.format_preset.empty()) e << YAML::Key << "format" << YAML::Value << c.imu.format_preset;
-    if (!c.imu.spec_preset.empty() || c.imu.spec.name == "inline") {
+    if (c.imu.spec_auto) {
+      e << YAML::Key << "spec" << YAML::Value << "auto";
+    } else if (!c.imu.spec_preset.empty() || c.imu.spec.name == "inline") {
       e << YAML::Key << "spec" << YAML::Value;
       emit_imu_spec(e, c.imu.spec, c.imu.spec_preset);
     }

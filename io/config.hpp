@@ -55,6 +55,9 @@ struct ImuConfig {
   ins::ImuSpec spec;          ///< resolved noise model (preset, possibly overridden by inline keys)
   bool has_format = false;    ///< imu.format was given
   bool has_spec = false;      ///< imu.spec was given
+  /// `imu.spec: auto`: the spec comes from the log's own calibration at run time (ins::spec_from_calibration,
+  /// docs/ins.md §10); `spec` holds it once resolved (pipeline/self_calibration).
+  bool spec_auto = false;
 };
 
 /// `reference:` section.
@@ -76,6 +79,12 @@ struct ZuptConfig {
   double shoe_sigma_accel_mps2 = 0.5;
   double shoe_sigma_gyro_radps = 0.1;     ///< key shoe_sigma_gyro_deg_per_s
   double shoe_threshold = 10.0;
+  /// `shoe_threshold: auto`: γ from the log's still floor of the statistic (ins::auto_shoe_threshold), with the
+  /// gait-adaptive raise next to a swing unless its keys are set (docs/zupt.md §6); resolved at run time.
+  bool shoe_threshold_auto = false;
+  bool edge_s_given = false;               ///< zupt.edge_s was in the file (else `auto` may choose it)
+  bool zaru_gate_given = false;            ///< zupt.zaru_gate_probability was in the file
+  bool zaru_sigma_given = false;           ///< zupt.zaru_sigma_deg_per_s was in the file
   double min_stance_s = 0.04;
   double are_threshold = 10.0;            ///< ARE γ (Skog et al. 2010 eq. 8)
   double mag_threshold = 2.0;             ///< MAG γ (Skog et al. 2010 eq. 9)

@@ -24,15 +24,22 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
     double sg = c.shoe_sigma_gyro_radps * kRadToDeg;
     z.number("shoe_sigma_gyro_deg_per_s", sg, false, 1e-6, 1000.0);
     c.shoe_sigma_gyro_radps = sg * kDegToRad;
-    z.number("shoe_threshold", c.shoe_threshold, false, 1e-9, 1e12);
+    if (z.has("shoe_threshold") && z.raw("shoe_threshold").IsScalar() && z.raw("shoe_threshold").Scalar() == "auto") {
+      c.shoe_threshold_auto = true;
+    } else {
+      z.number("shoe_threshold", c.shoe_threshold, false, 1e-9, 1e12);
+    }
     z.number("min_stance_s", c.min_stance_s, false, 0.0, 5.0);
     read_zupt_hmm_keys(z, c);
     z.number("sigma_mps", c.sigma_mps, false, 1e-6, 10.0);
+    c.edge_s_given = z.has("edge_s");
     z.number("edge_s", c.edge_s, false, 0.0, 1.0);
     z.boolean("zaru", c.zaru);
+    c.zaru_sigma_given = z.has("zaru_sigma_deg_per_s");
     double zs = c.zaru_sigma_radps * kRadToDeg;
     z.number("zaru_sigma_deg_per_s", zs, false, 1e-9, 100.0);
     c.zaru_sigma_radps = zs * kDegToRad;
+    c.zaru_gate_given = z.has("zaru_gate_probability");
     z.number("zaru_gate_probability", c.zaru_gate_probability, false, 0.0, 0.999999);
     if (c.zaru_gate_probability > 0.0 && c.zaru_gate_probability <= 0.5)
       z.problem("zaru_gate_probability", "must be 0 (no gate) or in (0.5, 1)");

@@ -190,7 +190,14 @@ void read_imu_section(YamlMap& top, ImuConfig& out) {
   }
   if (imu.has("spec")) {
     out.has_spec = true;
-    read_imu_spec_entry(imu, "spec", out.spec, out.spec_preset);
+    if (imu.raw("spec").IsScalar() && imu.raw("spec").Scalar() == "auto") {
+      out.spec_auto = true;  // resolved from the log at run time (pipeline/self_calibration)
+      out.spec.name = "auto";
+      std::string ignored;
+      imu.text("spec", ignored);  // mark the key as read
+    } else {
+      read_imu_spec_entry(imu, "spec", out.spec, out.spec_preset);
+    }
   }
 }
 

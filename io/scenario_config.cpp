@@ -1,6 +1,8 @@
 // Scenario YAML reader (README "Scenario files (pednav simulate)"). Unit-suffixed keys are converted to SI here.
 #include "io/scenario_config.hpp"
 
+#include "core/rotation.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -240,6 +242,11 @@ Expected<ScenarioFile> parse_scenario(const std::string& yaml_text, const std::s
       m.number("accel_quantum_mg", aq, false, 0.0, 1000.0);
       o.gyro_quantum_radps = gq * kDegToRad;
       o.accel_quantum_mps2 = aq * 1e-3 * kG0;
+      if (m.has("mounting_rpy_deg")) {  // the sensor's axes on the foot (sim::ImuOptions::R_b_s)
+        Eigen::Vector3d rpy = Eigen::Vector3d::Zero();
+        m.vector3("mounting_rpy_deg", rpy);
+        o.R_b_s = R_n_b_from_euler(rpy.x() * kDegToRad, rpy.y() * kDegToRad, rpy.z() * kDegToRad);
+      }
     }
     {
       YamlMap g = top.map("gnss");

@@ -176,7 +176,12 @@ Expected<RunInputs> load_run_inputs(const RunConfig& c) {
   if (!imu) return imu.error();
   for (const auto& w : imu->report.warnings) spdlog::warn("{}: {}", c.imu.file, w);
   d.imu = std::move(*imu);
-  d.options = engine_options(c);
+  d.config = c;
+  d.self_calibration = resolve_self_calibration(d.config, d.imu);
+  if (d.self_calibration) {
+    for (const auto& w : d.self_calibration->calibration.warnings) spdlog::warn("{}: calibration: {}", c.imu.file, w);
+  }
+  d.options = engine_options(d.config);
   if (d.options.mode != fusion::Mode::kTightlyCoupled) return d;
   gnss::SystemSelection sel{false, false, false, false, false};
   for (const auto& s : c.gnss.systems) {
@@ -245,7 +250,7 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
       !ok) {
     return ok.error();
   }
-  if (auto ok = write_file_atomic((out / "config.resolved.yaml").string(), to_yaml(c)); !ok) return ok.error();
+  if (auto ok = write_file_atomic((out / "config.resolved.yaml").string(), to_yaml(data.config)); !ok) return ok.error();
   if (opt.record_gnss_rows) {
     if (auto ok = write_residuals_csv((out / "residuals.csv").string(), res->gnss_rows); !ok) return ok.error();
   }
@@ -280,6 +285,7 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
     j["heading_init_distance_m"] = sum.heading_init_distance_m;
     j["heading_init_end_gps_tow_s"] = sum.heading_init_end->tow_s();
   }
+  if (data.self_calibration) j["self_calibration"] = self_calibration_json(*data.self_calibration);
   j["output_epochs"] = res->epochs.size();
   j["imu"] = {{"file", c.imu.file},
               {"rows", imu->report.rows},

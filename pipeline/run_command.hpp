@@ -10,6 +10,7 @@
 #include "fusion/engine.hpp"
 #include "gnss/types.hpp"
 #include "io/config.hpp"
+#include "pipeline/self_calibration.hpp"
 #include "io/imu_csv.hpp"
 #include "io/solution_writer.hpp"
 
@@ -21,6 +22,8 @@ fusion::EngineOptions engine_options(const io::RunConfig& config);
 /// The inputs of a run, read once: the IMU log and, in tc mode, rover/base observations and navigation data, with
 /// the engine options (base position from the configuration, else the RINEX header with a warning).
 struct RunInputs {
+  io::RunConfig config;  ///< the configuration with its `auto` settings resolved from the log (config.resolved.yaml)
+  std::optional<SelfCalibration> self_calibration;  ///< what the log said, when a setting was `auto`
   io::ImuLog imu;
   std::optional<gnss::ObsData> rover, base;
   std::optional<gnss::NavData> nav;

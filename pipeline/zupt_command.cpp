@@ -1,5 +1,7 @@
 #include "pipeline/zupt_command.hpp"
 
+#include "pipeline/self_calibration.hpp"
+
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -45,7 +47,9 @@ Expected<ZuptCommandSummary> run_zupt_command(const RunConfig& c, const std::str
   auto log = read_log(c);
   if (!log) return log.error();
   const std::vector<ins::ImuSample>* samples = &log->samples;
-  const ins::ZuptDetectorOptions opt = zupt_detector_options(c.zupt);
+  RunConfig resolved = c;  // `zupt.shoe_threshold: auto` from the log (pipeline/self_calibration)
+  resolve_self_calibration(resolved, *log);
+  const ins::ZuptDetectorOptions opt = zupt_detector_options(resolved.zupt);
   if (auto p = opt.problems(); !p.empty()) return make_error(c.source_file + ": " + p.front());
   if (auto p = ins::stance_label_problem(opt, &log->stance, samples->size()); !p.empty())
     return make_error(c.source_file + ": " + p);

@@ -52,9 +52,16 @@ struct BiasProcess {
 std::vector<ins::ImuSample> corrupt_imu(const std::vector<ins::ImuSample>& exact, const ImuOptions& o, uint64_t seed,
                                         ImuErrorTruth* truth) {
   ImuErrorTruth tr;
+  const bool mounted = !o.R_b_s.isIdentity(0.0);
   if (!o.errors) {
     if (truth) *truth = tr;
-    return exact;
+    if (!mounted) return exact;
+    std::vector<ins::ImuSample> out = exact;
+    for (auto& m : out) {
+      m.omega_ib_b = o.R_b_s.transpose() * m.omega_ib_b;
+      m.f_ib_b = o.R_b_s.transpose() * m.f_ib_b;
+    }
+    return out;
   }
   Rng r(seed, kStreamImu);
   const ins::ImuSpec& s = o.spec;
@@ -76,9 +83,14 @@ std::vector<ins::ImuSample> corrupt_imu(const std::vector<ins::ImuSample>& exact
   std::vector<ins::ImuSample> out;
   out.reserve(exact.size());
   for (size_t k = 0; k < exact.size(); ++k) {
-    const ins::ImuSample& e = exact[k];
+    ins::ImuSample e = exact[k];
+    if (mounted) {  // the sensor's axes (its errors act on them)
+      e.omega_ib_b = o.R_b_s.transpose() * e.omega_ib_b;
+      e.f_ib_b = o.R_b_s.transpose() * e.f_ib_b;
+    }
     const Eigen::Vector3d bgk = k == 0 ? Eigen::Vector3d(bg.gm + bg.walk) : bg.step(dt, r);
     const Eigen::Vector3d bak = k == 0 ? Eigen::Vector3d(ba.gm + ba.walk) : ba.step(dt, r);
+    if (k == 0) tr.b_g_first = tr.b_g0 + bgk;
     const Eigen::Vector3d w = Kg * e.omega_ib_b + tr.b_g0 + bgk + tr.G_g * e.f_ib_b + s.gyro_arw * sq_rate * normal3(r);
     const Eigen::Vector3d f = Ka * e.f_ib_b + tr.b_a0 + bak + s.accel_vrw * sq_rate * normal3(r);
     ins::ImuSample m;

@@ -12,6 +12,7 @@ namespace pednav::sim {
 /// The random constants drawn for one IMU (recorded so tests and users can compare estimates with them).
 struct ImuErrorTruth {
   Eigen::Vector3d b_g0 = Eigen::Vector3d::Zero();  ///< turn-on gyro bias [rad/s]
+  Eigen::Vector3d b_g_first = Eigen::Vector3d::Zero();  ///< total gyro bias at the first sample (turn-on + drift) [rad/s]
   Eigen::Vector3d b_a0 = Eigen::Vector3d::Zero();  ///< turn-on accelerometer bias [m/s^2]
   Eigen::Vector3d s_g = Eigen::Vector3d::Zero();   ///< gyro scale-factor errors [-]
   Eigen::Vector3d s_a = Eigen::Vector3d::Zero();   ///< accelerometer scale-factor errors [-]

@@ -49,6 +49,10 @@ struct ImuOptions {
   double gyro_g_sensitivity_sigma = 0.0;     ///< g-sensitive gyro bias, per matrix element [rad/s per m/s^2]
   double gyro_quantum_radps = 0.0;   ///< gyro output resolution [rad/s] (0 = none)
   double accel_quantum_mps2 = 0.0;   ///< accelerometer output resolution [m/s^2] (0 = none)
+  /// Mounting of the sensor on the foot: its axes -> the foot's body axes (forward, right, down), R_b_s, as in a
+  /// run configuration's imu.format mounting_rpy_deg; the written samples are on the sensor axes (R_b_sᵀ ω_b).
+  /// Identity: the sensor is the foot frame (z down at rest).
+  Eigen::Matrix3d R_b_s = Eigen::Matrix3d::Identity();
 };
 
 /// One C/N0 attenuation segment along the route distance of the walker.

@@ -353,3 +353,37 @@ TEST(Config, MultipathAndScaleFactorStateKeys) {
 
 }  // namespace
 }  // namespace pednav::io
+
+namespace pednav::io {
+namespace {
+
+// `imu.spec: auto` and `zupt.shoe_threshold: auto` (docs/ins.md §10, docs/zupt.md §6): parsed as flags resolved from
+// the log at run time; config.resolved.yaml of a run without a log reads back; a misspelt value names its key.
+TEST(Config, AutoSpecAndAutoThresholdAreFlagsAndMisspellingsAreNamed) {
+  const std::string base = "mode: ins\nimu:\n  file: imu.csv\n  format: pyshoe\n  spec: auto\n"
+                           "initial: {lat_deg: 45, lon_deg: 0, h_m: 0, yaw_deg: 0}\n";
+  auto cfg = parse(base + "zupt:\n  shoe_threshold: auto\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_TRUE(cfg->imu.spec_auto);
+  EXPECT_TRUE(cfg->imu.has_spec);
+  EXPECT_TRUE(cfg->zupt.shoe_threshold_auto);
+  EXPECT_FALSE(cfg->zupt.edge_s_given);
+  EXPECT_FALSE(cfg->zupt.zaru_gate_given);
+  auto again = parse(to_yaml(*cfg));
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_TRUE(again->imu.spec_auto);
+  auto given = parse(base + "zupt:\n  shoe_threshold: auto\n  edge_s: 0.02\n  zaru_gate_probability: 0\n");
+  ASSERT_TRUE(given) << given.error().message;
+  EXPECT_TRUE(given->zupt.edge_s_given);
+  EXPECT_TRUE(given->zupt.zaru_gate_given);
+  auto bad = parse(base + "zupt:\n  shoe_threshold: automatic\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("zupt.shoe_threshold"));
+  bad = parse("mode: ins\nimu:\n  file: imu.csv\n  format: pyshoe\n  spec: autox\n"
+              "initial: {lat_deg: 45, lon_deg: 0, h_m: 0, yaw_deg: 0}\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("unknown IMU spec preset 'autox'"));
+}
+
+}  // namespace
+}  // namespace pednav::io

@@ -1,0 +1,187 @@
+// ins::calibrate_imu on synthetic logs whose truth is known: still periods, bias, noise density, gravity axis, rate,
+// gait, and the warnings of logs that cannot tell everything (docs/ins.md §10).
+#include "ins/calibration.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "core/geodesy.hpp"
+#include "core/rotation.hpp"
+
+namespace pednav::ins {
+namespace {
+
+using Eigen::Vector3d;
+using ::testing::HasSubstr;
+
+constexpr double kG = 9.80665;
+
+// A synthetic foot log on the sensor axes: still (bias + white noise, gravity along `up_s`), then `strides` strides
+// of 1.1 s (a swing with a 6 rad/s pitch-rate peak and a 4 m/s² specific-force swing, then 0.35 s of stance), then
+// still again.
+struct Synthetic {
+  double rate_hz = 500.0;
+  double still_start_s = 5.0, still_end_s = 3.0;
+  int strides = 20;
+  Vector3d bias_radps = Vector3d(0.004, -0.007, 0.009);
+  double gyro_sigma = 0.02;   // per sample [rad/s]
+  double accel_sigma = 0.05;  // per sample [m/s²]
+  Vector3d up_s = Vector3d::UnitZ();
+  std::vector<ImuSample> make(unsigned seed = 7) const {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> n(0.0, 1.0);
+    std::vector<ImuSample> s;
+    const double dt = 1.0 / rate_hz;
+    const double total = still_start_s + strides * 1.1 + still_end_s;
+    const Vector3d across = up_s.unitOrthogonal();
+    for (long k = 0; k * dt < total; ++k) {
+      const double t = k * dt;
+      Vector3d w = Vector3d::Zero(), f = kG * up_s;
+      const double tw = t - still_start_s;
+      if (tw >= 0.0 && tw < strides * 1.1) {
+        const double phase = std::fmod(tw, 1.1);
+        if (phase < 0.75) {  // swing
+          const double x = std::sin(3.14159265358979 * phase / 0.75);
+          w = 6.0 * x * across;
+          f += 4.0 * x * up_s.cross(across);
+        }
+      }
+      ImuSample m;
+      m.t = GpsTime::from_ns(2300LL * kNsPerWeek + static_cast<int64_t>(std::llround(t * 1e9)));
+      m.omega_ib_b = w + bias_radps + gyro_sigma * Vector3d(n(rng), n(rng), n(rng));
+      m.f_ib_b = f + accel_sigma * Vector3d(n(rng), n(rng), n(rng));
+      s.push_back(m);
+    }
+    return s;
+  }
+};
+
+TEST(Calibration, RecoversBiasNoiseGravityAxisRateAndGait) {
+  Synthetic syn;
+  syn.up_s = Vector3d(0.0, std::sin(30.0 * kDegToRad), std::cos(30.0 * kDegToRad));  // z up, rolled 30°
+  const ImuCalibration c = calibrate_imu(syn.make());
+  EXPECT_NEAR(c.rate_hz, 500.0, 1e-6);
+  EXPECT_LT(c.dt_jitter_s, 1e-9);
+  ASSERT_EQ(c.still.size(), 2u);
+  EXPECT_NEAR(c.still[0].t0_s, 0.0, 1e-9);
+  EXPECT_NEAR(c.still[0].duration_s, 5.0, 0.5);  // whole 0.5-s windows
+  EXPECT_NEAR(c.still[1].duration_s, 3.0, 0.5);
+  ASSERT_TRUE(c.bias_estimated);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(c.gyro_bias_radps(i), syn.bias_radps(i), 3.0 * c.gyro_bias_sd_radps(i)) << i;
+    EXPECT_NEAR(c.gyro_bias_sd_radps(i), syn.gyro_sigma / std::sqrt(5.0 * syn.rate_hz), 0.2 * c.gyro_bias_sd_radps(i));
+  }
+  ASSERT_TRUE(c.noise_estimated);
+  const double gyro_density = syn.gyro_sigma / std::sqrt(syn.rate_hz);
+  const double accel_density = syn.accel_sigma / std::sqrt(syn.rate_hz);
+  for (int i = 0; i < 3; ++i) {  // 8 s of still samples: the estimate is within a few per cent
+    EXPECT_NEAR(c.gyro_noise_density(i), gyro_density, 0.05 * gyro_density) << i;
+    EXPECT_NEAR(c.accel_noise_density(i), accel_density, 0.05 * accel_density) << i;
+  }
+  EXPECT_EQ(c.up_axis, "+z");
+  EXPECT_NEAR(c.tilt_deg, 30.0, 0.5);
+  EXPECT_NEAR(c.gravity_mps2, kG, 0.01);
+  EXPECT_EQ(c.footfalls, syn.strides);
+  EXPECT_NEAR(c.stride_cadence_per_min, 60.0 / 1.1, 0.5);
+  ASSERT_EQ(c.warnings.size(), 1u);  // the tilt, and nothing else
+  EXPECT_THAT(c.warnings.front(), HasSubstr("up is 30 deg from the nearest sensor axis"));
+}
+
+TEST(Calibration, ALogThatNeverStandsStillSaysWhatItCannotEstimate) {
+  Synthetic syn;
+  syn.still_start_s = 0.0;
+  syn.still_end_s = 0.0;
+  const ImuCalibration c = calibrate_imu(syn.make());
+  EXPECT_FALSE(c.bias_estimated);
+  EXPECT_TRUE(c.still.empty());
+  ASSERT_FALSE(c.warnings.empty());
+  EXPECT_THAT(c.warnings.front(), HasSubstr("no still period of 1.0 s or more"));
+  EXPECT_EQ(c.footfalls, syn.strides);
+  // The auto spec falls back to its floors.
+  const ImuSpec s = spec_from_calibration(c);
+  const AutoSpecOptions o;
+  EXPECT_DOUBLE_EQ(s.gyro_arw, o.gyro_noise_floor);
+  EXPECT_DOUBLE_EQ(s.gyro_bias_initial, o.gyro_bias_initial_floor);
+}
+
+TEST(Calibration, ALogThatOnlyStandsHasNoGait) {
+  Synthetic syn;
+  syn.strides = 0;
+  const ImuCalibration c = calibrate_imu(syn.make());
+  EXPECT_TRUE(c.bias_estimated);
+  EXPECT_EQ(c.footfalls, 0);
+  bool said = false;
+  for (const auto& w : c.warnings) said |= w.find("no steps in this log") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
+TEST(Calibration, FiftyHertzAndGravityOnXAreNamed) {
+  Synthetic syn;
+  syn.rate_hz = 50.0;
+  syn.up_s = -Vector3d::UnitX();
+  const ImuCalibration c = calibrate_imu(syn.make());
+  EXPECT_NEAR(c.rate_hz, 50.0, 1e-6);
+  EXPECT_EQ(c.up_axis, "-x");
+  EXPECT_NEAR(c.tilt_deg, 0.0, 0.5);
+  bool said = false;
+  for (const auto& w : c.warnings) said |= w.find("50 Hz sample rate") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
+TEST(Calibration, SaturationPlateausRepeatedSamplesAndWrongUnitsAreFound) {
+  Synthetic syn;
+  auto s = syn.make();
+  for (auto& m : s) m.omega_ib_b.x() = std::clamp(m.omega_ib_b.x(), -5.0, 5.0);  // no swing reaches x: none clipped
+  for (auto& m : s) m.omega_ib_b = m.omega_ib_b.cwiseMax(-4.0).cwiseMin(4.0);    // the 6 rad/s swings clip at 4
+  for (size_t k = 1000; k < 1100; ++k) s[k].omega_ib_b = s[999].omega_ib_b, s[k].f_ib_b = s[999].f_ib_b;
+  const ImuCalibration c = calibrate_imu(s);
+  EXPECT_NEAR(c.gyro_plateau_radps, 4.0, 1e-12);
+  EXPECT_GT(c.gyro_saturated_samples, 100);
+  EXPECT_EQ(c.repeated_samples, 100);
+  const ImuSpec spec = spec_from_calibration(c);
+  EXPECT_NEAR(spec.gyro_range, 4.0, 1e-12);
+  // Specific force in g instead of m/s²: no window is near 1 g, so nothing is called still.
+  for (auto& m : s) m.f_ib_b /= kG;
+  const ImuCalibration g = calibrate_imu(s);
+  EXPECT_FALSE(g.bias_estimated);
+}
+
+TEST(Calibration, AutoThresholdIsTheRestLevelPlusTheMotionAllowance) {
+  Synthetic syn;
+  const auto s = syn.make();
+  const ImuCalibration c = calibrate_imu(s);
+  std::vector<double> t(s.size(), 100.0);
+  for (const auto& p : c.still) {
+    for (size_t i = p.begin; i < p.end; ++i) t[i] = 0.01 * static_cast<double>(i % 100) / 99.0;  // 0 .. 0.01
+  }
+  const AutoThresholdOptions o;
+  const AutoThreshold a = auto_shoe_threshold(t, c, o);
+  EXPECT_TRUE(a.from_still);
+  EXPECT_NEAR(a.rest, 0.0099, 1e-4);  // the 99th percentile of 0 .. 0.01
+  EXPECT_DOUBLE_EQ(a.threshold, a.rest + o.motion);
+  ImuCalibration none = c;
+  none.still.clear();
+  const AutoThreshold b = auto_shoe_threshold(t, none, o);
+  EXPECT_FALSE(b.from_still);
+  EXPECT_LT(b.rest, 0.011);  // the 5th percentile: still samples are 8 s of 30
+}
+
+TEST(Calibration, AutoSpecCoversTheMeasuredBiasAndKeepsTheNoiseFloors) {
+  Synthetic syn;
+  syn.gyro_sigma = 0.2;  // a noisy sensor: 0.2 rad/s per sample at 500 Hz = 32 deg/sqrt(h), above the floor
+  syn.bias_radps = Vector3d(0.02, -0.03, 0.01);
+  const ImuCalibration c = calibrate_imu(syn.make());
+  const ImuSpec s = spec_from_calibration(c);
+  EXPECT_NEAR(s.gyro_arw, c.gyro_noise_density.maxCoeff(), 1e-15);
+  EXPECT_GT(s.gyro_arw, AutoSpecOptions{}.gyro_noise_floor);
+  EXPECT_DOUBLE_EQ(s.accel_vrw, AutoSpecOptions{}.accel_noise_floor);  // 0.05 per sample is below the floor
+  EXPECT_NEAR(s.gyro_bias_initial, c.gyro_bias_radps.cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_GT(s.gyro_bias_initial, 0.025);
+  EXPECT_TRUE(s.problems().empty());
+}
+
+}  // namespace
+}  // namespace pednav::ins

@@ -1,0 +1,177 @@
+// The out-of-the-box configuration (datasets/foot/pyshoe_auto.yaml: `imu.spec: auto`, `zupt.shoe_threshold: auto`,
+// every other key default) on all 24 PyShoe Vicon trials, scored as scripts/pyshoe_cv does, and on the x-io loops.
+// The auto knobs (motion allowance 1.5, the ZARU gate and stance edges of `auto`) were chosen on the 4 `original`
+// trials only; the 20 `added` trials and the x-io loops are held out (docs/results.md "Out of the box").
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "io/config.hpp"
+#include "pipeline/compare_command.hpp"
+#include "pipeline/run_command.hpp"
+#include "tests/support/data.hpp"
+
+namespace pednav::pipeline {
+namespace {
+
+using namespace pednav::io;
+
+// Measured 2026-12-05 (Release; scripts/pyshoe_cv datasets/foot/pyshoe_auto.yaml): tuning median 0.90x PyShoe's
+// per-trial tuned error, worst 1.03x; held out median 1.39x, worst 30.4x (2018-02-09-11-22-01: stances of the first
+// slow shuffling steps missed, 2.02 m), pednav better than PyShoe with one threshold on 15 of 20, mean 0.231 m.
+// Bounds: measured + 5 % (deterministic runs; the margin is for another libm), counts exact. Issue 37's targets
+// (held-out median <= 1.0x, worst <= 2.0x, >= 90 % better than one threshold) are NOT met and not asserted.
+constexpr double kTuningMedianMax = 0.90 * 1.05;
+constexpr double kTuningWorstMax = 1.03 * 1.05;
+constexpr double kHeldOutMedianMax = 1.39 * 1.05;
+constexpr double kHeldOutWorstMax = 30.4 * 1.05;
+constexpr int kHeldOutBeatsOneThresholdMin = 15;
+// x-io loops with the same configuration (held out), measured 0.025 m / 0.192 m end-point error (the committed x-io
+// configuration, chosen on these loops: 0.023 / 0.122 m).
+constexpr double kXioShortClosureMax_m = 0.025 * 1.05;
+constexpr double kXioLongClosureMax_m = 0.192 * 1.05;
+
+struct Trial {
+  std::string name, split;
+  double tuned_m = 0.0, one_threshold_m = 0.0, pednav_m = 0.0;
+};
+
+std::vector<Trial> read_trials() {
+  std::vector<Trial> out;
+  std::ifstream in(test::shared_data("foot_pyshoe_vicon/trials.csv"));
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> head;
+  {
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) head.push_back(c);
+  }
+  auto col = [&](const char* name) { return std::find(head.begin(), head.end(), name) - head.begin(); };
+  const auto i_trial = col("trial"), i_split = col("split"), i_tuned = col("pyshoe_tuned_mean_horizontal_m"),
+             i_one = col("pyshoe_one_threshold_mean_horizontal_m");
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    if (cells.size() < head.size()) continue;
+    out.push_back({cells[i_trial], cells[i_split], std::stod(cells[i_tuned]), std::stod(cells[i_one]), 0.0});
+  }
+  return out;
+}
+
+std::filesystem::path fresh_dir(const std::string& name) {
+  const auto d = std::filesystem::temp_directory_path() / ("pednav_data_foot_auto_" + name);
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+// scripts/pyshoe_cv's figure: start-aligned mean horizontal error against the Vicon (e = gt_y, n = gt_x).
+double run_trial(const std::string& trial) {
+  const std::string log = test::shared_data("foot_pyshoe_vicon/csv/" + trial + ".csv");
+  const auto out = fresh_dir(trial);
+  {
+    std::ifstream in(log);
+    std::ofstream ref(out / "ref.csv");
+    std::string line;
+    std::getline(in, line);
+    ref << "gps_week,gps_tow_s,e_m,n_m,u_m\n";
+    while (std::getline(in, line)) {
+      std::stringstream ss(line);
+      std::string cell[10];
+      for (auto& c : cell) std::getline(ss, c, ',');
+      ref << "0," << cell[0] << ',' << cell[8] << ',' << cell[7] << ',' << cell[9] << '\n';
+    }
+  }
+  auto cfg = load_run_config(test::source_path("datasets/foot/pyshoe_auto.yaml"));
+  EXPECT_TRUE(cfg) << cfg.error().message;
+  if (!cfg) return 1e9;
+  cfg->imu.file = log;
+  auto sum = run_run_command(*cfg, (out / "run").string());
+  EXPECT_TRUE(sum) << trial << ": " << sum.error().message;
+  if (!sum) return 1e9;
+  CompareArgs args;
+  args.solution = (out / "run" / "solution.csv").string();
+  args.reference = (out / "ref.csv").string();
+  args.out_dir = (out / "cmp").string();
+  args.compare.align = eval::Align::kStart;
+  args.plots = false;
+  auto ev = run_compare(args);
+  EXPECT_TRUE(ev) << trial << ": " << ev.error().message;
+  return ev ? ev->horizontal_mean_m : 1e9;
+}
+
+struct GroupFigures {
+  double median = 0.0, worst = 0.0;
+  int beats = 0, trials = 0;
+};
+GroupFigures figures(const std::vector<Trial>& t, bool tuning) {
+  GroupFigures g;
+  std::vector<double> r;
+  for (const auto& x : t) {
+    if ((x.split == "original") != tuning) continue;
+    r.push_back(x.pednav_m / x.tuned_m);
+    g.beats += x.pednav_m < x.one_threshold_m;
+  }
+  g.trials = static_cast<int>(r.size());
+  if (r.empty()) return g;
+  std::sort(r.begin(), r.end());
+  g.median = r.size() % 2 ? r[r.size() / 2] : 0.5 * (r[r.size() / 2 - 1] + r[r.size() / 2]);
+  g.worst = r.back();
+  return g;
+}
+
+TEST(DataFootAuto, PyshoeTrialsTuningSubsetAndHeldOut) {
+  PEDNAV_REQUIRE_DATA(test::shared_data("foot_pyshoe_vicon/trials.csv"));
+  std::vector<Trial> trials = read_trials();
+  ASSERT_EQ(trials.size(), 24u);
+  for (auto& t : trials) t.pednav_m = run_trial(t.name);
+  const GroupFigures tune = figures(trials, true), held = figures(trials, false);
+  ASSERT_EQ(tune.trials, 4);
+  ASSERT_EQ(held.trials, 20);
+  std::printf("[pyshoe auto] tuning: median %.3fx, worst %.3fx, %d/4 better than one threshold; held out: median "
+              "%.3fx, worst %.2fx, %d/20 better than one threshold\n",
+              tune.median, tune.worst, tune.beats, held.median, held.worst, held.beats);
+  EXPECT_LT(tune.median, kTuningMedianMax);
+  EXPECT_LT(tune.worst, kTuningWorstMax);
+  EXPECT_EQ(tune.beats, 4);
+  EXPECT_LT(held.median, kHeldOutMedianMax);
+  EXPECT_LT(held.worst, kHeldOutWorstMax);
+  EXPECT_GE(held.beats, kHeldOutBeatsOneThresholdMin);
+}
+
+TEST(DataFootAuto, XioLoopsWithTheSameConfiguration) {
+  PEDNAV_REQUIRE_DATA(test::shared_data("foot_xio_ngimu_loops/short_walk.csv"));
+  for (const auto& [loop, bound] : {std::pair<std::string, double>{"short", kXioShortClosureMax_m},
+                                    {"long", kXioLongClosureMax_m}}) {
+    auto base = load_run_config(test::source_path("datasets/foot/xio_" + loop + ".yaml"));
+    ASSERT_TRUE(base) << base.error().message;
+    auto cfg = load_run_config(test::source_path("datasets/foot/pyshoe_auto.yaml"));
+    ASSERT_TRUE(cfg) << cfg.error().message;
+    cfg->imu.file = base->imu.file;  // the log, its format and its place; every filter key from pyshoe_auto.yaml
+    cfg->imu.format = base->imu.format;
+    cfg->imu.format_preset = base->imu.format_preset;
+    cfg->initial = base->initial;
+    const auto out = fresh_dir("xio_" + loop);
+    auto sum = run_run_command(*cfg, (out / "run").string());
+    ASSERT_TRUE(sum) << sum.error().message;
+    CompareArgs args;
+    args.solution = (out / "run" / "solution.csv").string();
+    args.reference = args.solution;
+    args.out_dir = (out / "cmp").string();
+    args.compare.align = eval::Align::kStart;
+    args.compare.loop = true;
+    args.plots = false;
+    auto ev = run_compare(args);
+    ASSERT_TRUE(ev) << ev.error().message;
+    std::printf("[xio %s auto] closure %.3f m of %.1f m\n", loop.c_str(), ev->closure_m, ev->distance_m);
+    EXPECT_LT(ev->closure_m, bound) << loop;
+  }
+}
+
+}  // namespace
+}  // namespace pednav::pipeline

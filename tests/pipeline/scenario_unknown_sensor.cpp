@@ -1,0 +1,85 @@
+// A foot IMU nobody tuned pednav to (issue 37; datasets/unknown_sensor.yaml): seed 004's indoor loops with the sensor
+// mounted z axis up and rolled 30° about the foot's long axis, a 0.5 °/s turn-on gyro bias σ, 3× the Crista's white
+// noise, 500 Hz. `pednav calibrate` must recover what it can see, and `imu.spec: auto` + `zupt.shoe_threshold: auto`
+// must close the loop (docs/ins.md §10, docs/zupt.md §6).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+
+#include "core/geodesy.hpp"
+#include "core/rotation.hpp"
+#include "io/config.hpp"
+#include "io/scenario_config.hpp"
+#include "pipeline/calibrate_command.hpp"
+#include "pipeline/compare_command.hpp"
+#include "pipeline/run_command.hpp"
+#include "pipeline/simulate_command.hpp"
+#include "sim/simulator.hpp"
+#include "tests/sim/fixtures.hpp"
+#include "tests/support/data.hpp"
+
+namespace pednav {
+namespace {
+
+// Measured 2026-12-05 (Release, this scenario, seed 4137): closure 0.31 % of 188 m, horizontal RMS 0.41 m against the
+// truth. The same log with the configuration `pednav simulate` writes (the Crista preset, SHOE γ 10, which happens to
+// be the sensor's own family) closes at 0.54 % with an RMS of 1.35 m; with the first auto threshold design (a factor
+// of the rest level) 7-18 %. Bounds: the issue's 1 % closure; the RMS at the measured 0.41 m + 30 % (runs are
+// deterministic; the margin is for another libm), which the non-auto configuration does not meet.
+constexpr double kMaxClosurePct = 1.0;
+constexpr double kMaxRms_m = 0.55;
+// Calibration (measured: ARW 18.3 / 18.0 / 17.6 deg/sqrt(h) against the simulated 18; +z up, 30.2° tilt).
+constexpr double kNoiseTolerance = 0.2;  // issue 37: noise density within 20 %
+
+TEST(UnknownSensor, CalibrateRecoversTheSensorAndAutoClosesTheLoop) {
+  auto file = io::load_scenario(test::source_path("datasets/unknown_sensor.yaml"));
+  ASSERT_TRUE(file) << file.error().message;
+  const std::string dir = test::temp_dir("unknown_sensor");
+  ASSERT_TRUE(pipeline::run_simulate_command(*file, dir).has_value());
+  auto truth_sim = sim::simulate(file->scenario);  // the same seed: the truth of the written files
+  ASSERT_TRUE(truth_sim) << truth_sim.error().message;
+
+  auto cfg = io::load_run_config(dir + "/config.yaml");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  auto cal = pipeline::run_calibrate_command(*cfg, dir + "/cal");
+  ASSERT_TRUE(cal) << cal.error().message;
+  const ins::ImuCalibration& c = cal->self.calibration;
+  EXPECT_NEAR(c.rate_hz, 500.0, 1e-6);
+  EXPECT_EQ(c.up_axis, "+z");
+  EXPECT_NEAR(c.tilt_deg, 30.0, 1.0);
+  ASSERT_TRUE(c.bias_estimated);
+  // The truth at the first sample, on the sensor axes: turn-on bias + drift + the Earth rate.
+  const Eigen::Matrix3d R_b_s = file->scenario.imu.R_b_s;
+  const Eigen::Vector3d earth_s = R_b_s.transpose() * truth_sim->truth.nav.front().R_e_b().transpose() *
+                                  Eigen::Vector3d(0.0, 0.0, wgs84::kOmegaIE_radps);
+  const Eigen::Vector3d b_true = truth_sim->imu_errors.b_g_first + earth_s;
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(c.gyro_bias_radps(i), b_true(i), 3.0 * c.gyro_bias_sd_radps(i)) << "axis " << i;
+  }
+  const double arw_true = 18.0 * kDegToRad / 60.0, vrw_true = 0.353 / 60.0;
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(c.gyro_noise_density(i), arw_true, kNoiseTolerance * arw_true) << "axis " << i;
+    EXPECT_NEAR(c.accel_noise_density(i), vrw_true, kNoiseTolerance * vrw_true) << "axis " << i;
+  }
+
+  cfg->imu.spec_auto = true;
+  cfg->zupt.shoe_threshold_auto = true;
+  auto sum = pipeline::run_run_command(*cfg, dir + "/run");
+  ASSERT_TRUE(sum) << sum.error().message;
+  pipeline::CompareArgs args;
+  args.solution = dir + "/run/solution.csv";
+  args.reference = dir + "/truth.csv";
+  args.out_dir = dir + "/cmp";
+  args.compare.loop = true;
+  args.plots = false;
+  auto ev = pipeline::run_compare(args);
+  ASSERT_TRUE(ev) << ev.error().message;
+  std::printf("[unknown sensor, auto] closure %.3f m = %.2f %% of %.1f m, RMS %.3f m\n", ev->closure_m,
+              ev->closure_pct_of_distance, ev->distance_m, ev->horizontal_rms_m);
+  EXPECT_LT(ev->closure_pct_of_distance, kMaxClosurePct);
+  EXPECT_LT(ev->horizontal_rms_m, kMaxRms_m);
+}
+
+}  // namespace
+}  // namespace pednav
