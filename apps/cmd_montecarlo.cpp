@@ -1,6 +1,8 @@
 // `pednav montecarlo SCENARIO.yaml --runs N -o OUT`: the flags; the study is pipeline/montecarlo_command.
 #include <spdlog/spdlog.h>
 
+#include <sstream>
+
 #include "apps/commands.hpp"
 #include "pipeline/montecarlo_command.hpp"
 
@@ -73,9 +75,47 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
   cmd->add_flag("--step-velocity", mo->step_velocity, "Seed 000 step-averaged velocity aiding");
   cmd->add_option("--leg-length-m", mo->leg_length_m, "Inverted-pendulum length l of the step-length model [m]")
       ->check(CLI::Range(0.05, 3.0));
-  cmd->callback([&action, mo] {
+  auto shard = std::make_shared<std::string>();
+  cmd->add_option("--shard", *shard,
+                  "K/N: run only this share of the seeds (runs i with i mod N = K-1) into OUT/runs and OUT/shard.json, "
+                  "for a cluster; combine the N folders with pednav montecarlo-merge (docs/scale.md)");
+  cmd->callback([&action, mo, shard] {
+    if (!shard->empty()) {
+      int k = 0, n = 0;
+      char slash = 0;
+      std::istringstream in(*shard);
+      if (!(in >> k >> slash >> n) || slash != '/' || !in.eof() || n < 1 || k < 1 || k > n)
+        throw CLI::ValidationError("--shard", "expected K/N with 1 <= K <= N, got '" + *shard + "'");
+      mo->shard_index = k;
+      mo->shard_count = n;
+    }
     action = [mo] {
       if (auto ok = pipeline::run_montecarlo_command(*mo); !ok) {
+        spdlog::error("{}", ok.error().message);
+        return 1;
+      }
+      return 0;
+    };
+  });
+}
+
+}  // namespace pednav::apps
+
+namespace pednav::apps {
+
+void add_montecarlo_merge_command(CLI::App& app, Action& action) {
+  auto* cmd = app.add_subcommand("montecarlo-merge",
+                                 "Combine the shard folders of one pednav montecarlo --shard K/N study into runs.csv, "
+                                 "nees.csv, summary.json and the figures, as one process writes them");
+  auto out = std::make_shared<std::string>();
+  auto dirs = std::make_shared<std::vector<std::string>>();
+  auto plots = std::make_shared<bool>(true);
+  cmd->add_option("OUT", *out, "Output folder")->required();
+  cmd->add_option("SHARD_DIR", *dirs, "The shard output folders (each with shard.json and runs/)")->required();
+  cmd->add_flag("!--no-plots", *plots, "No SVG figures");
+  cmd->callback([&action, out, dirs, plots] {
+    action = [out, dirs, plots] {
+      if (auto ok = pipeline::run_montecarlo_merge(*out, *dirs, *plots); !ok) {
         spdlog::error("{}", ok.error().message);
         return 1;
       }

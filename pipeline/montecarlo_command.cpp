@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -73,7 +74,8 @@ std::vector<eval::McEpoch> errors(const sim::Simulation& s, const std::vector<fu
     m.distance_m = i < static_cast<long>(s.antenna.size()) ? s.antenna[i].route_m : 0.0;
     const Eigen::Vector3d enu = enu_from_ecef(e.nav.p_eb_e, nav[i].p_eb_e);
     m.err_ned_m = Eigen::Vector3d(enu.y(), enu.x(), -enu.z());
-    m.cov_ned_m2 = e.cov_p_n;
+    // Symmetric, as the run file stores it (upper triangle): a run read back aggregates to the same bits.
+    m.cov_ned_m2 = 0.5 * (e.cov_p_n + e.cov_p_n.transpose());
     m.err_yaw_rad = wrap_pi(yaw_n(e.nav) - yaw_n(nav[i]));
     m.var_yaw_rad2 = e.sd_yaw_rad * e.sd_yaw_rad;
     out.push_back(m);
@@ -167,7 +169,7 @@ constexpr const char* kRunHeader =
 
 Expected<void> write_run(const std::string& path, const RunRecord& r) {
   std::ostringstream o;
-  o.precision(10);
+  o.precision(17);  // lossless: a run read back (resume, shard merge) aggregates to the same bits as one in memory
   std::string msg = r.message;
   std::replace(msg.begin(), msg.end(), '\n', ' ');
   o << "# index=" << r.index << " seed=" << r.seed << " ok=" << r.ok << " wall_s=" << r.wall_s
@@ -260,56 +262,9 @@ void nees_rows(std::ostringstream& o, const char* sol, const std::vector<eval::M
   }
 }
 
-}  // namespace
-
-Expected<void> run_montecarlo_command(const MontecarloArgs& mo) {
-  const auto t_start = std::chrono::steady_clock::now();
-  auto file = io::load_scenario(mo.scenario_path);
-  if (!file) return file.error();
-  std::error_code ec;
-  std::filesystem::create_directories(std::filesystem::path(mo.out_dir) / "runs", ec);
-  if (ec) return make_error(fmt::format("{}: cannot create the output folder: {}", mo.out_dir, ec.message()));
-  // Resume: runs whose file exists are read, not redone.
-  std::vector<RunRecord> records(mo.runs);
-  std::vector<int> todo;
-  for (int i = 0; i < mo.runs; ++i) {
-    const std::string p = run_file(mo.out_dir, i);
-    if (std::filesystem::exists(p)) {
-      auto r = read_run(p);
-      if (!r) return make_error(r.error().message + " (delete it to redo that run)");
-      records[i] = std::move(*r);
-    } else {
-      todo.push_back(i);
-    }
-  }
-  if (todo.size() < static_cast<size_t>(mo.runs)) {
-    spdlog::info("montecarlo: {} of {} runs already done in {}, {} to run", mo.runs - todo.size(), mo.runs,
-                 mo.out_dir, todo.size());
-  }
-  const int jobs = std::max(1, mo.jobs > 0 ? mo.jobs : static_cast<int>(std::thread::hardware_concurrency()));
-  std::atomic<size_t> next{0};
-  std::mutex mu;
-  std::string write_error;
-  io::Progress progress("montecarlo", static_cast<int64_t>(todo.size()), io::progress_enabled());
-  int64_t done = 0;
-  auto worker = [&] {
-    for (;;) {
-      const size_t k = next++;
-      if (k >= todo.size()) return;
-      RunRecord r = run_one(*file, mo, todo[k]);
-      const auto w = write_run(run_file(mo.out_dir, r.index), r);
-      std::lock_guard<std::mutex> lock(mu);
-      if (!w && write_error.empty()) write_error = w.error().message;
-      records[r.index] = std::move(r);
-      progress.update(++done);
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int j = 0; j < std::min<int>(jobs, static_cast<int>(todo.size())); ++j) threads.emplace_back(worker);
-  for (auto& t : threads) t.join();
-  progress.finish();
-  if (!write_error.empty()) return make_error(write_error);
-
+// runs.csv, nees.csv, summary.json and the figures from every run's record (one process, or merged shards).
+Expected<void> aggregate(const MontecarloArgs& mo, const std::string& scenario_name, const std::vector<RunRecord>& records,
+                         size_t done_now, int jobs, std::chrono::steady_clock::time_point t_start) {
   // runs.csv
   std::vector<eval::McRun> ok_runs;
   std::ostringstream rc;
@@ -348,11 +303,11 @@ Expected<void> run_montecarlo_command(const MontecarloArgs& mo) {
   const eval::McSummary ss = eval::summarize(smo, n_ok, mo.summary_from_s);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   nlohmann::json j;
-  j["scenario"] = file->scenario.name;
+  j["scenario"] = scenario_name;
   j["runs"] = n_ok;
   j["runs_requested"] = mo.runs;
   j["runs_failed"] = mo.runs - n_ok;
-  j["runs_done_now"] = todo.size();
+  j["runs_done_now"] = done_now;
   j["jobs"] = jobs;
   j["nees_in_band_fraction_forward"] = sf.nees_in_band_fraction;
   // No smoothed epochs (--no-smoother, or a re-initialized run): null, not 0.
@@ -388,7 +343,7 @@ Expected<void> run_montecarlo_command(const MontecarloArgs& mo) {
     if (auto w = io::write_file_atomic((std::filesystem::path(mo.out_dir) / name).string(), text); !w) return w.error();
   }
   if (mo.plots) {  // seed 000 Figs. 4-6 (gnuplot; a missing gnuplot costs the figures, not the run)
-    const std::string what = fmt::format("{}, {} runs", file->scenario.name, n_ok);
+    const std::string what = fmt::format("{}, {} runs", scenario_name, n_ok);
     const std::vector<eval::McEpochStats> none;
     const auto& smo_or_none = have_smoothed ? smo : none;
     for (const auto& [name, spec] : std::vector<std::pair<std::string, io::PlotSpec>>{
@@ -418,6 +373,200 @@ Expected<void> run_montecarlo_command(const MontecarloArgs& mo) {
                n_ok, mo.runs - n_ok, wall, jobs, 100.0 * sf.nees_in_band_fraction, sf.epochs,
                sf.sigma_ratio_horizontal, sf.sigma_ratio_yaw, sf.rms_horizontal_m, smoothed_text, mo.out_dir);
   return {};
+}
+
+// What a shard's runs depend on, as JSON: the scenario text and every option that changes a run or the aggregation
+// (not the output folder, the thread count, the figures or the shard itself).
+nlohmann::ordered_json study_json(const MontecarloArgs& a) {
+  nlohmann::ordered_json j;
+  j["runs"] = a.runs;
+  j["mode"] = a.mode;
+  j["zupt_form"] = a.zupt_form;
+  j["smoother"] = a.smoother;
+  j["seed_offset"] = a.seed_offset;
+  j["summary_from_s"] = a.summary_from_s;
+  j["zupt_updates"] = a.zupt_updates;
+  j["step_velocity"] = a.step_velocity;
+  j["leg_length_m"] = a.leg_length_m;
+  j["multipath_states"] = a.multipath_states;
+  j["white_code"] = a.white_code;
+  j["scale_states"] = a.scale_states;
+  j["accel_scale_states"] = a.accel_scale_states;
+  j["bias_random_walk"] = a.bias_random_walk;
+  j["no_scale_states"] = a.no_scale_states;
+  j["gauss_markov_bias"] = a.gauss_markov_bias;
+  j["saturation_repair"] = a.saturation_repair;
+  j["no_doppler"] = a.no_doppler;
+  j["foot_antenna_velocity"] = a.foot_antenna_velocity;
+  j["scale_bias_compensation"] = a.scale_bias_compensation ? nlohmann::json(*a.scale_bias_compensation) : nullptr;
+  j["smoother_eiv_regression"] = a.smoother_eiv_regression ? nlohmann::json(*a.smoother_eiv_regression) : nullptr;
+  j["elevation_weight"] = std::isnan(a.elevation_weight) ? nlohmann::json(nullptr) : nlohmann::json(a.elevation_weight);
+  j["scenario_lever_arm"] = a.scenario_lever_arm;
+  j["g_sensitivity_states"] = a.g_sensitivity_states;
+  j["window_s"] = a.window_s;
+  j["receiver_weights"] = a.receiver_weights;
+  return j;
+}
+
+// FNV-1a 64-bit of a text (a stable fingerprint on every platform; not a cryptographic hash).
+std::string fnv1a(const std::string& text) {
+  uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  return fmt::format("{:016x}", h);
+}
+
+std::string study_fingerprint(const MontecarloArgs& a) {
+  std::ifstream in(a.scenario_path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return fnv1a(text.str() + "\n" + study_json(a).dump());
+}
+
+// OUT/shard.json: which shard of which study, the seeds it ran, and how they went.
+Expected<void> write_shard(const MontecarloArgs& mo, const io::ScenarioFile& file, const std::vector<int>& mine,
+                           const std::vector<RunRecord>& records, size_t done_now,
+                           std::chrono::steady_clock::time_point t_start) {
+  int ok = 0;
+  for (int i : mine) ok += records[i].ok;
+  nlohmann::ordered_json j;
+  j["study_fingerprint"] = study_fingerprint(mo);
+  j["scenario"] = file.scenario.name;
+  j["shard"] = mo.shard_index;
+  j["shards"] = mo.shard_count;
+  j["study"] = study_json(mo);
+  j["run_indices"] = mine;
+  j["runs_ok"] = ok;
+  j["runs_failed"] = static_cast<int>(mine.size()) - ok;
+  j["runs_done_now"] = done_now;
+  j["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  if (auto w = io::write_file_atomic((std::filesystem::path(mo.out_dir) / "shard.json").string(), j.dump(2) + "\n"); !w)
+    return w.error();
+  spdlog::info("montecarlo: shard {}/{}: {} runs ({} failed) -> {} (merge with pednav montecarlo-merge)", mo.shard_index,
+               mo.shard_count, mine.size(), mine.size() - ok, mo.out_dir);
+  return {};
+}
+
+}  // namespace
+
+Expected<void> run_montecarlo_command(const MontecarloArgs& mo) {
+  if (mo.shard_count < 1 || mo.shard_index < 1 || mo.shard_index > mo.shard_count) {
+    return make_error(fmt::format("--shard {}/{}: expected K/N with 1 <= K <= N", mo.shard_index, mo.shard_count));
+  }
+  const auto t_start = std::chrono::steady_clock::now();
+  auto file = io::load_scenario(mo.scenario_path);
+  if (!file) return file.error();
+  std::error_code ec;
+  std::filesystem::create_directories(std::filesystem::path(mo.out_dir) / "runs", ec);
+  if (ec) return make_error(fmt::format("{}: cannot create the output folder: {}", mo.out_dir, ec.message()));
+  // This process's share of the seeds (all of them unless --shard K/N: runs i with i mod N = K - 1).
+  std::vector<int> mine;
+  for (int i = 0; i < mo.runs; ++i) {
+    if (i % mo.shard_count == mo.shard_index - 1) mine.push_back(i);
+  }
+  // Resume: runs whose file exists are read, not redone.
+  std::vector<RunRecord> records(mo.runs);
+  std::vector<int> todo;
+  for (int i : mine) {
+    const std::string p = run_file(mo.out_dir, i);
+    if (std::filesystem::exists(p)) {
+      auto r = read_run(p);
+      if (!r) return make_error(r.error().message + " (delete it to redo that run)");
+      records[i] = std::move(*r);
+    } else {
+      todo.push_back(i);
+    }
+  }
+  if (todo.size() < mine.size()) {
+    spdlog::info("montecarlo: {} of {} runs already done in {}, {} to run", mine.size() - todo.size(), mine.size(),
+                 mo.out_dir, todo.size());
+  }
+  const int jobs = std::max(1, mo.jobs > 0 ? mo.jobs : static_cast<int>(std::thread::hardware_concurrency()));
+  std::atomic<size_t> next{0};
+  std::mutex mu;
+  std::string write_error;
+  io::Progress progress("montecarlo", static_cast<int64_t>(todo.size()), io::progress_enabled());
+  int64_t done = 0;
+  auto worker = [&] {
+    for (;;) {
+      const size_t k = next++;
+      if (k >= todo.size()) return;
+      RunRecord r = run_one(*file, mo, todo[k]);
+      const auto w = write_run(run_file(mo.out_dir, r.index), r);
+      std::lock_guard<std::mutex> lock(mu);
+      if (!w && write_error.empty()) write_error = w.error().message;
+      records[r.index] = std::move(r);
+      progress.update(++done);
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int j = 0; j < std::min<int>(jobs, static_cast<int>(todo.size())); ++j) threads.emplace_back(worker);
+  for (auto& t : threads) t.join();
+  progress.finish();
+  if (!write_error.empty()) return make_error(write_error);
+
+  if (mo.shard_count > 1) return write_shard(mo, *file, mine, records, todo.size(), t_start);
+  return aggregate(mo, file->scenario.name, records, todo.size(), jobs, t_start);
+}
+
+}  // namespace pednav::pipeline
+
+namespace pednav::pipeline {
+
+Expected<void> run_montecarlo_merge(const std::string& out_dir, const std::vector<std::string>& shard_dirs, bool plots) {
+  const auto t_start = std::chrono::steady_clock::now();
+  if (shard_dirs.empty()) return make_error("montecarlo-merge: no shard folders given");
+  std::string fingerprint, scenario;
+  int shards = 0, runs = 0;
+  MontecarloArgs mo;
+  std::map<int, std::string> shard_dir;  // shard number -> folder
+  for (const auto& d : shard_dirs) {
+    const std::string path = (std::filesystem::path(d) / "shard.json").string();
+    std::ifstream in(path);
+    if (!in) return make_error(path + ": cannot read (not the output folder of pednav montecarlo --shard K/N?)");
+    const auto j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded() || !j.contains("study_fingerprint") || !j.contains("shard") || !j.contains("study"))
+      return make_error(path + ": not a shard manifest (study_fingerprint, shard, study expected)");
+    if (fingerprint.empty()) {
+      fingerprint = j["study_fingerprint"];
+      scenario = j.value("scenario", "");
+      shards = j["shards"];
+      runs = j["study"]["runs"];
+      mo.runs = runs;
+      mo.summary_from_s = j["study"]["summary_from_s"];
+      mo.window_s = j["study"]["window_s"];
+    } else if (j["study_fingerprint"] != fingerprint || j["shards"] != shards) {
+      return make_error(fmt::format("{}: shard of a different study (scenario text, options or shard count differ from "
+                                    "{})", path, shard_dirs.front()));
+    }
+    const int k = j["shard"];
+    if (auto [it, fresh] = shard_dir.emplace(k, d); !fresh)
+      return make_error(fmt::format("shard {}/{} given twice: {} and {}", k, shards, it->second, d));
+  }
+  std::string missing;
+  for (int k = 1; k <= shards; ++k) {
+    if (!shard_dir.count(k)) missing += (missing.empty() ? "" : ", ") + std::to_string(k);
+  }
+  if (!missing.empty()) return make_error(fmt::format("missing shards {} of {}", missing, shards));
+  std::error_code ec;
+  std::filesystem::create_directories(std::filesystem::path(out_dir) / "runs", ec);
+  if (ec) return make_error(fmt::format("{}: cannot create the output folder: {}", out_dir, ec.message()));
+  std::vector<RunRecord> records(runs);
+  for (int i = 0; i < runs; ++i) {
+    const std::string from = run_file(shard_dir.at(i % shards + 1), i);
+    auto r = read_run(from);
+    if (!r) return make_error(r.error().message + " (shard " + std::to_string(i % shards + 1) + " incomplete?)");
+    std::ifstream src(from, std::ios::binary);
+    std::ostringstream text;
+    text << src.rdbuf();
+    if (auto w = io::write_file_atomic(run_file(out_dir, i), text.str()); !w) return w.error();
+    records[i] = std::move(*r);
+  }
+  mo.out_dir = out_dir;
+  mo.plots = plots;
+  return aggregate(mo, scenario, records, 0, 1, t_start);
 }
 
 }  // namespace pednav::pipeline

@@ -10,6 +10,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/expected.hpp"
 #include "fusion/step_velocity.hpp"
@@ -48,10 +49,19 @@ struct MontecarloArgs {
   double window_s = 150.0;         ///< summary.json windows_*: the band test per window of this length [s]
   bool plots = true;               ///< nees.svg, sigma.svg, sigma_yaw.svg, error_vs_distance.svg
   bool receiver_weights = false;   ///< code/Doppler weights from the scenario's receiver model (docs/consistency.md §3.8)
+  /// --shard K/N: only runs i with i mod N = K − 1, into out_dir/runs/ with out_dir/shard.json (no statistics);
+  /// run_montecarlo_merge combines the N folders into what one process gives.
+  int shard_index = 1;
+  int shard_count = 1;
 };
 
 /// Runs the study into args.out_dir (resumable: existing runs/run_NNNN.csv are read, not redone); logs progress and
 /// the summary line; fails with the message of the first problem (scenario, output folder, a run file, < 2 runs).
 Expected<void> run_montecarlo_command(const MontecarloArgs& args);
+
+/// `pednav montecarlo-merge OUT SHARD_DIR...`: the shards of one study (same scenario text and options, every shard
+/// 1..N exactly once) → OUT/runs/, runs.csv, nees.csv, summary.json and (with plots) the figures, exactly as one
+/// process writes them except the wall-clock fields. Errors name the missing, duplicated or foreign shard.
+Expected<void> run_montecarlo_merge(const std::string& out_dir, const std::vector<std::string>& shard_dirs, bool plots);
 
 }  // namespace pednav::pipeline
