@@ -18,6 +18,7 @@ void add_run_command(CLI::App& app, Action& action);
 void add_calibrate_command(CLI::App& app, Action& action);
 void add_montecarlo_command(CLI::App& app, Action& action);
 void add_montecarlo_merge_command(CLI::App& app, Action& action);
+void add_batch_command(CLI::App& app, Action& action);
 void add_outage_command(CLI::App& app, Action& action);
 void add_report_command(CLI::App& app, Action& action);
 void add_zupt_command(CLI::App& app, Action& action);

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   pednav::apps::add_calibrate_command(app, action);
   pednav::apps::add_montecarlo_command(app, action);
   pednav::apps::add_montecarlo_merge_command(app, action);
+  pednav::apps::add_batch_command(app, action);
   pednav::apps::add_outage_command(app, action);
   pednav::apps::add_report_command(app, action);
   pednav::apps::add_zupt_command(app, action);
