@@ -21,6 +21,10 @@ void add_config_check_command(CLI::App& app, Action& action) {
         spdlog::error("{}", cfg.error().message);
         return 1;
       }
+      if (const auto missing = io::missing_input_files(*cfg); !missing.empty()) {
+        for (const auto& m : missing) spdlog::error("{}: {}", *path, m);
+        return 1;
+      }
       std::fputs(io::to_yaml(*cfg).c_str(), stdout);
       return 0;
     };

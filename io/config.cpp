@@ -49,7 +49,8 @@ Expected<RunConfig> parse_run_config(const std::string& yaml_text, const std::st
       out.number("rate_hz", cfg.output.rate_hz, false, 1e-6, 1000.0);
       out.strings("formats", cfg.output.formats);
       for (const auto& f : cfg.output.formats) {
-        if (f != "csv" && f != "pos") out.problem("formats", "unknown output format '" + f + "' (expected csv, pos)");
+        if (f != "csv" && f != "pos" && f != "geojson" && f != "kml")
+          out.problem("formats", "unknown output format '" + f + "' (expected csv, pos, geojson, kml)");
       }
     }
     // Mode-dependent required inputs.
@@ -170,6 +171,22 @@ std::string to_yaml(const RunConfig& c) {
     << c.output.rate_hz << YAML::Key << "formats" << YAML::Value << YAML::Flow << c.output.formats << YAML::EndMap;
   e << YAML::EndMap;
   return std::string(e.c_str()) + "\n";
+}
+
+std::vector<std::string> missing_input_files(const RunConfig& c) {
+  std::vector<std::string> out;
+  auto check = [&](const std::string& key, const std::string& path) {
+    if (!path.empty() && !std::filesystem::exists(path)) out.push_back(key + ": " + path + " does not exist");
+  };
+  check("imu.file", c.imu.file);
+  if (c.mode != "ins") {
+    check("rover_obs", c.gnss.rover_obs);
+    check("base_obs", c.gnss.base_obs);
+    for (const auto& n : c.gnss.nav) check("nav", n);
+  }
+  check("reference.file", c.reference.file);
+  check("zupt.hmm_model", c.zupt.hmm_model_file);
+  return out;
 }
 
 }  // namespace pednav::io

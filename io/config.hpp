@@ -213,6 +213,12 @@ ImuErrorModelChoice imu_error_model_choice(const RunConfig& c);
 
 /// Read and validate a run configuration; every problem is reported at once ("file:line: yaml.path: what").
 Expected<RunConfig> load_run_config(const std::string& path);
+
+/// The configured input files that do not exist, one line each naming the key and the path ("reference.file:
+/// /x/ref.csv does not exist"): the IMU log, rover/base obs, nav files, reference, HMM model. Checked by
+/// `pednav config-check` and before any processing by every command that reads them (none of them computes first
+/// and fails at the end).
+std::vector<std::string> missing_input_files(const RunConfig& config);
 /// Same from YAML text; `source_name` names it in messages, `base_dir` resolves relative paths.
 Expected<RunConfig> parse_run_config(const std::string& yaml_text, const std::string& source_name,
                                      const std::string& base_dir);

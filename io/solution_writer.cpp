@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 
 #include "core/geodesy.hpp"
@@ -70,6 +71,117 @@ Expected<void> write_solution_pos(const std::string& path, const std::vector<Sol
                      signed_sqrt(-P(1, 2)), signed_sqrt(-P(2, 0)), r.age_s, 0.0);
   }
   return f.commit();
+}
+
+namespace {
+
+struct Ellipse {
+  double major_m = 0.0, minor_m = 0.0, orientation_deg = 0.0;  // 1σ semi-axes, major axis clockwise from north
+};
+Ellipse horizontal_ellipse(const Eigen::Matrix3d& cov_n) {
+  const Eigen::Matrix2d c = cov_n.topLeftCorner<2, 2>();  // N, E
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(c);
+  Ellipse e;
+  e.major_m = std::sqrt(std::max(0.0, es.eigenvalues()(1)));
+  e.minor_m = std::sqrt(std::max(0.0, es.eigenvalues()(0)));
+  const Eigen::Vector2d v = es.eigenvectors().col(1);  // (north, east)
+  double az = std::atan2(v.y(), v.x()) * kRadToDeg;
+  if (az < 0.0) az += 180.0;
+  if (az >= 180.0) az -= 180.0;
+  e.orientation_deg = az;
+  return e;
+}
+
+std::string utc_iso(GpsTime t) {
+  const CalendarTime c = t.to_utc();
+  return fmt::format("{:04d}-{:02d}-{:02d}T{:02d}:{:02d}:{:06.3f}Z", c.year, c.month, c.day, c.hour, c.minute, c.second);
+}
+
+std::string xml_escape(const std::string& s) {
+  std::string o;
+  for (char ch : s) {
+    switch (ch) {
+      case '&': o += "&amp;"; break;
+      case '<': o += "&lt;"; break;
+      case '>': o += "&gt;"; break;
+      case '"': o += "&quot;"; break;
+      default: o += ch;
+    }
+  }
+  return o;
+}
+
+std::string json_escape(const std::string& s) {
+  std::string o;
+  for (char ch : s) {
+    if (ch == '"' || ch == '\\') o += '\\';
+    if (static_cast<unsigned char>(ch) < 0x20) {
+      o += fmt::format("\\u{:04x}", static_cast<int>(ch));
+      continue;
+    }
+    o += ch;
+  }
+  return o;
+}
+
+}  // namespace
+
+Expected<void> write_solution_geojson(const std::string& path, const std::vector<SolutionRow>& rows,
+                                      const std::string& title) {
+  std::string o = "{\"type\": \"FeatureCollection\", \"name\": \"" + json_escape(title) + "\", \"features\": [\n";
+  o += "{\"type\": \"Feature\", \"properties\": {\"name\": \"track\", \"epochs\": " + std::to_string(rows.size()) +
+       "}, \"geometry\": {\"type\": \"LineString\", \"coordinates\": [";
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const Geodetic g = geodetic_from_ecef(rows[i].p_e);
+    o += fmt::format("{}[{:.9f}, {:.9f}, {:.4f}]", i ? ", " : "", g.lon * kRadToDeg, g.lat * kRadToDeg, g.h_m);
+  }
+  o += "]}}";
+  for (const SolutionRow& r : rows) {
+    const Geodetic g = geodetic_from_ecef(r.p_e);
+    const Ellipse e = horizontal_ellipse(r.cov_p_n);
+    o += fmt::format(
+        ",\n{{\"type\": \"Feature\", \"geometry\": {{\"type\": \"Point\", \"coordinates\": [{:.9f}, {:.9f}, {:.4f}]}}, "
+        "\"properties\": {{\"gps_week\": {}, \"gps_tow_s\": {:.3f}, \"utc\": \"{}\", \"sd_n_m\": {:.4f}, \"sd_e_m\": {:.4f}, "
+        "\"sd_d_m\": {:.4f}, \"sigma_major_m\": {:.4f}, \"sigma_minor_m\": {:.4f}, \"orientation_deg\": {:.2f}, "
+        "\"n_sats_used\": {}, \"zupt\": {}}}}}",
+        g.lon * kRadToDeg, g.lat * kRadToDeg, g.h_m, r.time.week(), r.time.tow_s(), utc_iso(r.time),
+        std::sqrt(std::max(0.0, r.cov_p_n(0, 0))), std::sqrt(std::max(0.0, r.cov_p_n(1, 1))),
+        std::sqrt(std::max(0.0, r.cov_p_n(2, 2))), e.major_m, e.minor_m, e.orientation_deg, r.n_sats_used,
+        r.zupt ? (*r.zupt ? "true" : "false") : "null");
+  }
+  o += "\n]}\n";
+  return write_file_atomic(path, o);
+}
+
+Expected<void> write_solution_kml(const std::string& path, const std::vector<SolutionRow>& rows, const std::string& title) {
+  std::string o = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<kml xmlns=\"http://www.opengis.net/kml/2.2\">\n<Document>\n";
+  o += "<name>" + xml_escape(title) + "</name>\n";
+  o += "<Style id=\"track\"><LineStyle><color>ff0000ff</color><width>2</width></LineStyle></Style>\n";
+  o += "<Style id=\"epoch\"><IconStyle><scale>0.4</scale></IconStyle><LabelStyle><scale>0</scale></LabelStyle></Style>\n";
+  o += "<Placemark><name>track</name><styleUrl>#track</styleUrl><LineString><altitudeMode>clampToGround</altitudeMode>"
+       "<coordinates>\n";
+  for (const SolutionRow& r : rows) {
+    const Geodetic g = geodetic_from_ecef(r.p_e);
+    o += fmt::format("{:.9f},{:.9f},{:.4f}\n", g.lon * kRadToDeg, g.lat * kRadToDeg, g.h_m);
+  }
+  o += "</coordinates></LineString></Placemark>\n<Folder><name>epochs</name>\n";
+  for (const SolutionRow& r : rows) {
+    const Geodetic g = geodetic_from_ecef(r.p_e);
+    const Ellipse e = horizontal_ellipse(r.cov_p_n);
+    o += fmt::format(
+        "<Placemark><name>{:.3f}</name><styleUrl>#epoch</styleUrl><TimeStamp><when>{}</when></TimeStamp>"
+        "<ExtendedData><Data name=\"gps_week\"><value>{}</value></Data><Data name=\"gps_tow_s\"><value>{:.3f}</value></Data>"
+        "<Data name=\"sd_n_m\"><value>{:.4f}</value></Data><Data name=\"sd_e_m\"><value>{:.4f}</value></Data>"
+        "<Data name=\"sd_d_m\"><value>{:.4f}</value></Data><Data name=\"sigma_major_m\"><value>{:.4f}</value></Data>"
+        "<Data name=\"sigma_minor_m\"><value>{:.4f}</value></Data><Data name=\"orientation_deg\"><value>{:.2f}</value></Data>"
+        "<Data name=\"n_sats_used\"><value>{}</value></Data></ExtendedData>"
+        "<Point><coordinates>{:.9f},{:.9f},{:.4f}</coordinates></Point></Placemark>\n",
+        r.time.tow_s(), utc_iso(r.time), r.time.week(), r.time.tow_s(), std::sqrt(std::max(0.0, r.cov_p_n(0, 0))),
+        std::sqrt(std::max(0.0, r.cov_p_n(1, 1))), std::sqrt(std::max(0.0, r.cov_p_n(2, 2))), e.major_m, e.minor_m,
+        e.orientation_deg, r.n_sats_used, g.lon * kRadToDeg, g.lat * kRadToDeg, g.h_m);
+  }
+  o += "</Folder>\n</Document>\n</kml>\n";
+  return write_file_atomic(path, o);
 }
 
 }  // namespace pednav::io

@@ -38,4 +38,14 @@ Expected<void> write_solution_csv(const std::string& path, const std::vector<Sol
 Expected<void> write_solution_pos(const std::string& path, const std::vector<SolutionRow>& rows,
                                   const std::vector<std::string>& comment);
 
+/// GeoJSON (RFC 7946: WGS84 lon/lat/h in that order, no crs member) FeatureCollection: the track as one LineString
+/// Feature, then one Point Feature per row with its time (gps_week, gps_tow_s, utc ISO 8601) and σ (sd_n_m, sd_e_m,
+/// sd_d_m, the 1σ horizontal ellipse: semi-axes sigma_major_m / sigma_minor_m, orientation_deg clockwise from north),
+/// n_sats_used, zupt. Written atomically; opens in QGIS as is.
+Expected<void> write_solution_geojson(const std::string& path, const std::vector<SolutionRow>& rows,
+                                      const std::string& title);
+/// KML 2.2: a Document with the track as a LineString Placemark and one Point Placemark per row with its UTC
+/// TimeStamp (Google Earth's time slider) and the same σ values as ExtendedData. Written atomically.
+Expected<void> write_solution_kml(const std::string& path, const std::vector<SolutionRow>& rows, const std::string& title);
+
 }  // namespace pednav::io

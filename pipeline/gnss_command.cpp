@@ -102,6 +102,11 @@ std::string summary_json(const GnssRunSummary& s, const RunConfig& c) {
 
 Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::string& out_dir) {
   const auto start = std::chrono::steady_clock::now();
+  if (const auto missing = missing_input_files(config); !missing.empty()) {
+    std::string all;
+    for (const auto& m : missing) all += (all.empty() ? "" : "; ") + m;
+    return make_error(config.source_file + ": " + all);
+  }
   const GnssConfig& g = config.gnss;
   if (g.rover_obs.empty()) return make_error(config.source_file + ": rover_obs is required for pednav gnss");
   if (g.nav.empty()) return make_error(config.source_file + ": nav is required for pednav gnss");

@@ -171,6 +171,11 @@ Expected<RunInputs> load_run_inputs(const RunConfig& c) {
   if (!c.imu.has_spec) {
     return make_error(c.source_file + ": imu.spec: required for pednav run (a preset name or the noise values)");
   }
+  if (const auto missing = missing_input_files(c); !missing.empty()) {
+    std::string all;
+    for (const auto& m : missing) all += (all.empty() ? "" : "; ") + m;
+    return make_error(c.source_file + ": " + all);
+  }
   RunInputs d;
   auto imu = read_imu_csv(c.imu.file, c.imu.format);
   if (!imu) return imu.error();
@@ -251,6 +256,19 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
     return ok.error();
   }
   if (auto ok = write_file_atomic((out / "config.resolved.yaml").string(), to_yaml(data.config)); !ok) return ok.error();
+  // Map formats (output.formats: geojson, kml): the forward solution here, the smoothed one below.
+  auto write_maps = [&](const std::vector<SolutionRow>& r, const std::string& stem, const std::string& what) -> Expected<void> {
+    const auto& f = c.output.formats;
+    const std::string title = "pednav run " + c.mode + " (" + what + "): " + c.source_file;
+    if (std::find(f.begin(), f.end(), "geojson") != f.end()) {
+      if (auto ok = write_solution_geojson((out / (stem + ".geojson")).string(), r, title); !ok) return ok.error();
+    }
+    if (std::find(f.begin(), f.end(), "kml") != f.end()) {
+      if (auto ok = write_solution_kml((out / (stem + ".kml")).string(), r, title); !ok) return ok.error();
+    }
+    return {};
+  };
+  if (auto ok = write_maps(rows, "solution", "forward"); !ok) return ok.error();
   if (opt.record_gnss_rows) {
     if (auto ok = write_residuals_csv((out / "residuals.csv").string(), res->gnss_rows); !ok) return ok.error();
   }
@@ -266,6 +284,7 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
   }
   if (sum.smoothed) {
     if (auto ok = write_solution_csv((out / "smoothed.csv").string(), smoothed_rows); !ok) return ok.error();
+    if (auto ok = write_maps(smoothed_rows, "smoothed", "RTS smoothed"); !ok) return ok.error();
     if (auto ok = write_solution_pos((out / "solution_smoothed.pos").string(), smoothed_rows,
                                      {"pednav run (" + c.mode + ", RTS smoothed, IMU position)", c.source_file});
         !ok) {

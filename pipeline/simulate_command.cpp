@@ -108,8 +108,8 @@ std::string format_config(const sim::Simulation& s, const ScenarioFile& f, const
          "# --multipath-states, where they apply to this scenario; docs/sim.md §7, docs/consistency.md §3.8-3.11).\n";
     y += any_gnss ? "mode: tc\n" : "mode: ins\n";
   } else if (any_gnss) {
-    y += "# mode gnss: `pednav run` solves the GNSS epochs by least squares; `pednav run --mode tc` (or mode: tc) runs\n"
-         "# the tightly coupled filter.\nmode: gnss\n";
+    y += "# mode gnss: for `pednav gnss` (GNSS epochs by least squares); `pednav run --mode tc` (or mode: tc) runs the\n"
+         "# tightly coupled filter.\nmode: gnss\n";
   } else {
     y += "mode: ins\n";
   }

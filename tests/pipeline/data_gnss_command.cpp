@@ -256,7 +256,8 @@ TEST(GnssCommandBadInput, MissingEmptyAndTruncatedObs) {
   PEDNAV_REQUIRE_DATA(shared_data(kGalway + "rinex/rover-20181004-1532.obs"));
   auto missing = run(galway_yaml("[G]", "rinex/nonexistent.obs"), "bad_missing");
   ASSERT_FALSE(missing);
-  EXPECT_THAT(missing.error().message, HasSubstr("nonexistent.obs: file not found"));
+  // Checked before any processing, naming the key (io::missing_input_files).
+  EXPECT_THAT(missing.error().message, HasSubstr("base_obs: " + shared_data(kGalway + "rinex/nonexistent.obs") + " does not exist"));
 
   const std::string empty = ::testing::TempDir() + "pednav_gnss_empty.obs";
   { std::ofstream(empty).close(); }
