@@ -99,11 +99,6 @@ void RtsInterval::reexpress(int dst, int src, const Eigen::Matrix3d& B) {
   Gamma_.middleCols<3>(dst).noalias() += Gamma_.middleCols<3>(src) * B.transpose();
 }
 
-void RtsInterval::reexpress(const ErrorMatrix& J) {
-  tmp_.noalias() = Gamma_ * J.transpose();
-  Gamma_ = tmp_;
-}
-
 void RtsInterval::shift_mean_regressed(const int* states, const double* delta, int n, const ErrorMatrix& P) {
   constexpr int kMaxStates = 6;  // gyro + accelerometer scale factors
   using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxStates, kMaxStates>;

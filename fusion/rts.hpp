@@ -100,8 +100,6 @@ class RtsInterval {
   /// Re-expression of the error coordinates δx_new = J δx_old, J = I + E_dst B E_srcᵀ on two disjoint 3-blocks
   /// (form D, docs/fusion.md eq. 5.9): Γ ← Γ Jᵀ (eq. 12.18).
   void reexpress(int dst, int src, const Eigen::Matrix3d& B);
-  /// The same for a general (dense) J.
-  void reexpress(const ErrorMatrix& J);
   /// The filter fed back K r + delta instead of K r at state i, a state without process noise over the interval
   /// (a constant, or a slow Gauss-Markov state: the scale factors), and asserts the error after the update has zero
   /// mean (the errors-in-variables compensation of docs/consistency.md eq. E.4). For such a state Γ's row equals P's

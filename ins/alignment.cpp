@@ -83,29 +83,6 @@ double still_gyro_bias_d2(const Levelling& lv, double gyro_bias_initial_radps, d
   return lv.gyro_bias_b.squaredNorm() / (gyro_bias_initial_radps * gyro_bias_initial_radps + var_mean);
 }
 
-int initial_still_samples(const std::vector<ImuSample>& samples, const StillnessOptions& o) {
-  // Grow the window sample by sample with running sums; stop at the first sample that breaks the thresholds.
-  const int n = static_cast<int>(samples.size());
-  if (n < 2) return 0;
-  Eigen::Vector3d sw = Eigen::Vector3d::Zero(), sf = Eigen::Vector3d::Zero();
-  Eigen::Vector3d sww = Eigen::Vector3d::Zero(), sff = Eigen::Vector3d::Zero();
-  int still = 0;
-  for (int i = 0; i < n; ++i) {
-    sw += samples[i].omega_ib_b;
-    sf += samples[i].f_ib_b;
-    sww += samples[i].omega_ib_b.cwiseAbs2();
-    sff += samples[i].f_ib_b.cwiseAbs2();
-    const double k = i + 1;
-    if (k < 2) continue;
-    const Eigen::Vector3d vw = (sww / k - (sw / k).cwiseAbs2()).cwiseMax(0.0);
-    const Eigen::Vector3d vf = (sff / k - (sf / k).cwiseAbs2()).cwiseMax(0.0);
-    if (std::sqrt(vw.maxCoeff()) > o.max_gyro_std_radps || std::sqrt(vf.maxCoeff()) > o.max_accel_std_mps2) break;
-    still = i + 1;
-  }
-  if (still < 2 || samples[still - 1].t - samples.front().t < o.min_duration_s) return 0;
-  return still;
-}
-
 NavState nav_state_at_rest(GpsTime t, const Eigen::Vector3d& p_eb_e, double roll, double pitch, double yaw) {
   const Geodetic llh = geodetic_from_ecef(p_eb_e);
   NavState s;
@@ -114,13 +91,6 @@ NavState nav_state_at_rest(GpsTime t, const Eigen::Vector3d& p_eb_e, double roll
   s.v_eb_e.setZero();
   s.q_e_b = Eigen::Quaterniond(R_e_n(llh.lat, llh.lon) * R_n_b_from_euler(roll, pitch, yaw)).normalized();
   return s;
-}
-
-void set_heading(NavState& state, double yaw_rad) {
-  const Geodetic llh = geodetic_from_ecef(state.p_eb_e);
-  const Eigen::Matrix3d Ren = R_e_n(llh.lat, llh.lon);
-  const Eigen::Vector3d rpy = euler_from_R_n_b(Ren.transpose() * state.R_e_b());
-  state.q_e_b = Eigen::Quaterniond(Ren * R_n_b_from_euler(rpy.x(), rpy.y(), yaw_rad)).normalized();
 }
 
 double heading_from_magnetometer(const Eigen::Vector3d& m_b, double roll, double pitch, double declination_rad) {

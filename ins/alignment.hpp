@@ -38,10 +38,6 @@ struct Levelling {
 Expected<Levelling> coarse_level(const std::vector<ImuSample>& samples, const Eigen::Vector3d& p_eb_e,
                                  double yaw_rad = 0.0, const StillnessOptions& options = {});
 
-/// The number of leading samples that form a still window (moving-window test with the options above);
-/// 0 if the log does not start still.
-int initial_still_samples(const std::vector<ImuSample>& samples, const StillnessOptions& options = {});
-
 /// Normalized distance of a still window's gyro-bias estimate (lv.gyro_bias_b) from the turn-on prior N(0, σ_b0² I):
 /// d² = |b|² / (σ_b0² + ARW² / T), T = lv.duration_s (docs/ins.md §6, eq. 6.1). A detected stance is not always static
 /// (a foot that rolls at 1 deg/s before its first step); a d² beyond a χ²(3) quantile says the window moved and its
@@ -52,10 +48,8 @@ double still_gyro_bias_d2(const Levelling& lv, double gyro_bias_initial_radps, d
 /// (R_e_b = R_e_n(lat, lon) R_n_b(roll, pitch, yaw)).
 NavState nav_state_at_rest(GpsTime t, const Eigen::Vector3d& p_eb_e, double roll, double pitch, double yaw);
 
-/// Replace the heading (yaw [rad], 0 = north, +pi/2 = east) of a state, keeping roll and pitch.
-void set_heading(NavState& state, double yaw_rad);
-
-/// Heading [rad] from a magnetometer vector m_b (any unit) at the given roll/pitch [rad] plus the magnetic
+/// Heading [rad] from a magnetometer vector m_b (not yet wired to a command: issue 36 adds the magnetometer column and
+/// the run key) (any unit) at the given roll/pitch [rad] plus the magnetic
 /// declination [rad] (east positive): yaw = atan2(-m_y', m_x') + declination with m' levelled into the n-frame.
 double heading_from_magnetometer(const Eigen::Vector3d& m_b, double roll, double pitch, double declination_rad);
 

@@ -21,7 +21,8 @@ struct ImuErrors {
 
 /// Remove estimated biases, scale factors and the g-sensitive gyro error (G_g times the corrected velocity
 /// increment) from an increment (first order: the compensation terms are corrected with the same ratio as the plain
-/// increments).
+/// increments). A reference implementation for the tests: the engine corrects each sample (correct_sample) before
+/// integrating, and tests/ins/test_mechanization.cpp checks that both agree.
 ImuIncrement correct_increment(const ImuIncrement& inc, const ImuErrors& errors);
 
 /// Remove estimated biases and scale factors from one sample (use this before integration when the biases
