@@ -183,8 +183,8 @@ TEST(RobustGnssFault, NoFaultBaselineIsAccurateAndAccountsForEveryInput) {
   // largest from then on; the heading fit (until 79 s) and the end of the walk show no spike (docs/robustness.md §1).
   const GpsTime t_start = w.sim.truth.nav.front().t;
   const Errors e = errors(w, *r, t_start.plus_s(1.0));
-  std::printf("[ robust ] no fault: %ld epochs, horizontal RMS %.2f m, max %.2f m (first output epoch), max from 1 s on "
-              "%.2f m\n", e.n, e.rms, e.max, e.max_from);
+  std::printf("[ robust ] no fault: %ld epochs, horizontal RMS %.2f m, max %.2f m (first output epoch), max from 1 s "
+              "on %.2f m\n", e.n, e.rms, e.max, e.max_from);
   EXPECT_EQ(e.n, 205);  // 1 Hz over the 3.4-minute walk, plus the first step
   EXPECT_LT(e.rms, kMaxRmsNoFault_m);
   EXPECT_LT(e.max, kMaxFirstEpochNoFault_m);

@@ -55,8 +55,8 @@ constexpr double kSeed24WorstYawDeg = 1.59;
 // forest_walk (seed 2), measured 2026-12-05: yaw error 0.99° 60 s after the walk start, worst 2.38° until the end.
 constexpr double kYawErrorAt60sDeg = 0.99;
 constexpr double kWorstYawErrorDeg = 2.38;
-// Mean along-track error while walking, seed 2 (measured 2026-12-05: stride-average Doppler model −0.048 m, foot-velocity
-// model −0.351 m; earlier figures: without the scale-factor errors-in-variables compensation −0.24 / −0.54 m,
+// Mean along-track error while walking, seed 2 (measured 2026-12-05: stride-average Doppler model −0.048 m,
+// foot-velocity model −0.351 m; earlier figures: without the scale-factor errors-in-variables compensation −0.24 / −0.54 m,
 // with error-free IMU data −0.07 / −0.26 m; docs/fusion.md §13, docs/consistency.md §3.7). The default's mean is
 // near zero, so its bound takes an absolute margin, 0.05 m (more than 2× the figure: a relative margin of a
 // near-zero mean would be round-off); the foot model's lag must show: −20 % of its figure.
@@ -394,7 +394,7 @@ TEST_F(ForestWalkTc, HeadingFromMotionConvergesWithin60sOfWalking) {
   EXPECT_LT(first_after_deg, 1.30 * kYawErrorAt60sDeg);
 }
 
-// Regression (found 2026-12-01): with the old stop rule ("the GNSS epoch solutions have moved 30 m from the first one"),
+// Regression (found 2026-12-01): with the old stop rule ("the GNSS epoch solutions have moved 30 m from the first"),
 // forest_walk seed 24 ended the heading fit at 34 s into its 120 s static start, where a GNSS solution had jumped by
 // noise and blunders: the fit had nothing to rotate (yaw σ clamped at 30°), the filter started 139° off, collapsed
 // its yaw σ to 2° at a 71° error within 6 s of walking and diverged (forward RMS 8.2 m, one re-initialization).

@@ -68,7 +68,8 @@ NavState run(NavState s, const std::vector<ImuSample>& samples, double rate_hz,
 TEST(Mechanization, StationaryOneHourDriftsLessThanOneCentimetre) {
   constexpr double kTolHorizontal_m = 0.01;  // issue 12 "Done when"
   // Measured (2026-12-05, Release): max horizontal drift 9.39e-5 m, final vertical -9.55e-4 m (exact data: the drift
-  // is the mechanization's own discretization). Bounds +30 % (another libm/compiler; docs/conventions.md "Test bounds").
+  // is the mechanization's own discretization). Bounds +30 % (another libm/compiler; docs/conventions.md
+  // "Test bounds").
   constexpr double kMeasuredBoundHorizontal_m = 1.2e-4;
   constexpr double kMeasuredBoundVertical_m = 1.25e-3;
   const GpsTime t0 = GpsTime::from_week_tow(2000, 100.0);
