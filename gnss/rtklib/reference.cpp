@@ -80,4 +80,11 @@ void glonass_position(const GlonassEphemeris& g, GpsTime t, Eigen::Vector3d& p_e
   clock_bias_s = dts;
 }
 
+double klobuchar_delay_m(const std::array<double, 8>& alpha_beta, GpsTime t, const Geodetic& llh, double azimuth_rad,
+                         double elevation_rad) {
+  const double pos[3] = {llh.lat, llh.lon, llh.h_m};  // ionmodel: {lat, lon [rad], h [m]}
+  const double azel[2] = {azimuth_rad, elevation_rad};  // ionmodel: {az, el} [rad]
+  return ionmodel(to_gtime(t), alpha_beta.data(), pos, azel);
+}
+
 }  // namespace pednav::gnss::rtklib_reference

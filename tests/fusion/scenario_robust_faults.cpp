@@ -49,7 +49,11 @@ constexpr double kClockJump_s = 1e-3;           // issue 11: a 1 ms receiver clo
 constexpr double kBlunder_m = 300.0;            // issue 11: a 300 m pseudorange blunder on one satellite
 constexpr double kBlunderDuration_s = 60.0;
 constexpr double kOutage_s = 600.0;             // issue 11: 10 minutes without satellites
-constexpr double kMaxRmsNoFault_m = 2.0;        // forward TC on this walk (measured: see the printout)
+// The no-fault baseline (forward TC on this walk), measured 2026-12-05: 205 epochs, RMS 0.98 m, max 8.53 m at the
+// first output epoch, max 2.29 m from 1 s after the start on; bounds +20 % (another libm/compiler).
+constexpr double kMaxRmsNoFault_m = 0.98 * 1.2;
+constexpr double kMaxFirstEpochNoFault_m = 8.53 * 1.2;
+constexpr double kMaxAfterFirstSecondNoFault_m = 2.29 * 1.2;
 constexpr double kMaxRmsWithFault_m = 2.5;      // a handled fault costs little accuracy
 constexpr double kMaxErrorAfterRecovery_m = 5.0;// error from 60 s after a recovery / the end of an outage
 constexpr double kRecoveryTime_s = 60.0;
@@ -173,9 +177,18 @@ TEST(RobustGnssFault, NoFaultBaselineIsAccurateAndAccountsForEveryInput) {
   const Inputs in = inputs_of(w);
   auto r = run(w, in, w.options);
   ASSERT_TRUE(r) << r.error().message;
-  const Errors e = errors(w, *r, GpsTime{});
-  std::printf("[ robust ] no fault: %ld epochs, horizontal RMS %.2f m, max %.2f m\n", e.n, e.rms, e.max);
+  // The max (8.53 m) is the first output epoch, 0.05 s after the IMU start (one 20 Hz step): the position there is
+  // the GNSS epoch solution the filter started from (SD code of 5 satellites, one rejected; σ_N 2.65 m, σ_E 1.82 m),
+  // before any filtering: −6.89 m north, −5.03 m east, 2.6 and 2.8 σ. One second later the error is 2.29 m, the
+  // largest from then on; the heading fit (until 79 s) and the end of the walk show no spike (docs/robustness.md §1).
+  const GpsTime t_start = w.sim.truth.nav.front().t;
+  const Errors e = errors(w, *r, t_start.plus_s(1.0));
+  std::printf("[ robust ] no fault: %ld epochs, horizontal RMS %.2f m, max %.2f m (first output epoch), max from 1 s "
+              "on %.2f m\n", e.n, e.rms, e.max, e.max_from);
+  EXPECT_EQ(e.n, 205);  // 1 Hz over the 3.4-minute walk, plus the first step
   EXPECT_LT(e.rms, kMaxRmsNoFault_m);
+  EXPECT_LT(e.max, kMaxFirstEpochNoFault_m);
+  EXPECT_LT(e.max_from, kMaxAfterFirstSecondNoFault_m);
   EXPECT_TRUE(r->summary.covariance_healthy) << r->summary.health_message;
   EXPECT_EQ(r->summary.reinitializations, 0);
   expect_accounting(in, r->summary);

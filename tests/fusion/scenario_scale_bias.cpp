@@ -69,8 +69,9 @@ constexpr int kSeeds = 3;
 // +1.17 %), with 0.0032 (+0.38, −0.19, +0.38 %; 1.6 % subtracted in all).
 constexpr double kMaxRollWith = 0.005;
 constexpr double kMinRollWithout = 0.007;  // the defect must be visible, else the test proves nothing
-// Mean |ŝ_a z| (vertical accelerometer) the same way. Measured when written (session 10): without 0.0078, with the
-// diagonal footprints only (session 9) 0.0065, with the cross terms P_{s_t s_u} (eq. E.5) 0.0038.
+// Mean |ŝ_a z| (vertical accelerometer) the same way. Measured when written (2026-12-02): without 0.0078, with the
+// diagonal footprints only (the compensation before eq. E.5's cross terms) 0.0065, with the cross terms P_{s_t s_u}
+// (eq. E.5) 0.0038.
 constexpr double kMaxVerticalAccelWith = 0.005;
 constexpr double kMinVerticalAccelWithout = 0.006;
 

@@ -23,9 +23,10 @@ namespace {
 constexpr double kMaxRmsRatio = 0.7;          // issue 6: smoothed horizontal RMS <= 0.7 x forward
 constexpr double kMaxSmoothedRmsM = 1.2;      // issue 6
 constexpr double kMaxSmoothedMaxM = 4.0;      // issue 6
+constexpr double kMargin = 1.20;              // measured figure +20 % (docs/conventions.md "Test bounds")
 // Issue 6: >= 99 % of epochs with the smoothed N and E errors inside 3 sigma. With white code errors in R (the
-// default until session 4) it was 92.0 % (forward 83.2 %): the simulator's multipath is correlated for 20 s. With the
-// code-multipath Gauss-Markov states (default since session 4, docs/consistency.md §3): 100.0 % forward and smoothed.
+// default until 2026-12-01) it was 92.0 % (forward 83.2 %): the simulator's multipath is correlated for 20 s. With the
+// code-multipath Gauss-Markov states (default since 2026-12-01, docs/consistency.md §3): 100.0 % forward and smoothed.
 constexpr double kMinInside3SigmaPct = 99.0;
 constexpr double kSigmaSlackM2 = 1e-9;        // [m²] round-off allowance for smoothed var <= forward var
 constexpr double kSigmaSlackRad = 1e-9;       // [rad]
@@ -132,8 +133,18 @@ TEST_F(ForestWalkSmoother, SmoothedEpochsMatchForwardEpochs) {
     EXPECT_EQ(r.smoothed[k].t.ns(), r.epochs[k].t.ns());
     EXPECT_TRUE(r.smoothed[k].nav.p_eb_e.allFinite());
   }
-  // The last output epoch is (at most one step) before the end: there the two solutions nearly coincide.
-  EXPECT_LT((r.smoothed.back().nav.p_eb_e - r.epochs.back().nav.p_eb_e).norm(), 0.5);
+  // The two solutions coincide at the last STEP of the filter, not at the last output epoch: the 1 Hz output ends
+  // 0.280 s before the last IMU sample, and the backward pass starts from the tail (last output epoch -> last step,
+  // forward_runner.cpp, eq. 12.10) that carries the stance updates of those 0.28 s (no GNSS epoch: the next is 1 s
+  // later). Measured 2026-12-05: 1.78e-3 m between them at the last output epoch; bound +30 % (a millimetre-level
+  // difference of two solutions; another libm/compiler). A smoother that ignored the tail would give 0 here, one that
+  // started elsewhere decimetres: the bound's lower side is not checked (0 is a legitimate design).
+  const double last_diff_m = (r.smoothed.back().nav.p_eb_e - r.epochs.back().nav.p_eb_e).norm();
+  const double tail_s = g->sim.imu.back().t - r.epochs.back().t;
+  std::printf("[ smoother ] last output epoch: smoothed - forward %.4e m, %.3f s before the last IMU sample\n",
+              last_diff_m, tail_s);
+  EXPECT_LT(last_diff_m, 1.30 * 1.78e-3);
+  EXPECT_NEAR(tail_s, 0.280, 1e-6);  // from the data: the IMU log ends 0.28 s after a whole second
 }
 
 TEST_F(ForestWalkSmoother, SmoothedSigmaNotAboveForwardSigma) {
@@ -164,6 +175,18 @@ TEST_F(ForestWalkSmoother, AccuracyAndConsistency) {
   EXPECT_LE(s.rms, kMaxSmoothedRmsM);
   EXPECT_LE(s.max, kMaxSmoothedMaxM);
   EXPECT_GE(s.inside3_pct, kMinInside3SigmaPct);
+  // Measured 2026-12-05 (1081 epochs): forward RMS 1.08 m, p95 2.21 m, max 2.54 m, 100.0 % inside 3σ; smoothed
+  // 0.45 / 0.95 / 0.97 m, 100.0 %; ratio 0.418. Bounds +20 % (kMargin; another libm/compiler), 99.5 % for the shares.
+  EXPECT_EQ(f.n, 1081);
+  EXPECT_LT(f.rms, kMargin * 1.08);
+  EXPECT_LT(f.p95, kMargin * 2.21);
+  EXPECT_LT(f.max, kMargin * 2.54);
+  EXPECT_GE(f.inside3_pct, 99.5);
+  EXPECT_LT(s.rms, kMargin * 0.45);
+  EXPECT_LT(s.p95, kMargin * 0.95);
+  EXPECT_LT(s.max, kMargin * 0.97);
+  EXPECT_GE(s.inside3_pct, 99.5);
+  EXPECT_LT(s.rms / f.rms, kMargin * 0.418);
 }
 
 TEST_F(ForestWalkSmoother, SixtySecondOutage) {
@@ -179,6 +202,16 @@ TEST_F(ForestWalkSmoother, SixtySecondOutage) {
   EXPECT_GE(f.n, static_cast<long>(kOutageS) - 1);
   EXPECT_LT(s.max, f.max);
   EXPECT_LT(s.rms, f.rms);
+  // Measured 2026-12-05 (61 epochs): forward max 1.38 m, RMS 1.21 m; smoothed max 0.31 m, RMS 0.28 m, 100.0 % inside
+  // 3σ; whole run with the outage forward RMS 1.11 m, smoothed 0.44 m. Bounds +20 % (kMargin).
+  EXPECT_EQ(f.n, 61);
+  EXPECT_LT(f.max, kMargin * 1.38);
+  EXPECT_LT(f.rms, kMargin * 1.21);
+  EXPECT_LT(s.max, kMargin * 0.31);
+  EXPECT_LT(s.rms, kMargin * 0.28);
+  EXPECT_GE(s.inside3_pct, 99.5);
+  EXPECT_LT(fa.rms, kMargin * 1.11);
+  EXPECT_LT(sa.rms, kMargin * 0.44);
 }
 
 }  // namespace

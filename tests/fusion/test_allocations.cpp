@@ -67,7 +67,7 @@ void check_no_allocation_per_step(bool states) {
     o.estimate_scale_factors = true;
     o.zaru_gate_probability = 0.999;  // the gate's S = H P Hᵀ + R on fixed-capacity matrices too
   } else {
-    o.multipath_sigma_m = 0.0;  // white code errors (the multipath states are on by default since session 4)
+    o.multipath_sigma_m = 0.0;  // white code errors (the multipath states are on by default since 2026-12-01)
   }
   o.base_position_e = sim->gnss.p_base_e;
   fusion::EngineInputs in = test::engine_inputs(*sim);

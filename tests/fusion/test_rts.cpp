@@ -457,7 +457,7 @@ TEST(RtsInterval, EqualsPerStepCompositionWithReexpressionsAndResets) {
 // actually fed back, and the interval bookkeeping is told the deviation with shift_mean (eq. E.6). For a state without
 // process noise the smoothed estimate of that state (nominal + smoothed error) is one constant over the run, and both
 // formulations give it; without shift_mean the interval one drifts back by the deviations (what the engine's smoother
-// did before session 11).
+// did before eq. E.6 went in, 2026-12-03).
 TEST(RtsInterval, FeedbackDeviationOnAConstantStateKeepsItsSmoothedValueConstant) {
   std::mt19937 rng(20261202u);
   std::normal_distribution<double> nd(0.0, 1.0);

@@ -67,6 +67,11 @@ NavState run(NavState s, const std::vector<ImuSample>& samples, double rate_hz,
 
 TEST(Mechanization, StationaryOneHourDriftsLessThanOneCentimetre) {
   constexpr double kTolHorizontal_m = 0.01;  // issue 12 "Done when"
+  // Measured (2026-12-05, Release): max horizontal drift 9.39e-5 m, final vertical -9.55e-4 m (exact data: the drift
+  // is the mechanization's own discretization). Bounds +30 % (another libm/compiler; docs/conventions.md
+  // "Test bounds").
+  constexpr double kMeasuredBoundHorizontal_m = 1.2e-4;
+  constexpr double kMeasuredBoundVertical_m = 1.25e-3;
   const GpsTime t0 = GpsTime::from_week_tow(2000, 100.0);
   const NavState s0 =
       nav_state_from_ll(t0, 45.0, 7.0, 250.0, 0.1, -0.2, 1.0);  // tilted, heading 57 deg
@@ -79,6 +84,8 @@ TEST(Mechanization, StationaryOneHourDriftsLessThanOneCentimetre) {
   const Eigen::Vector3d d = ned_from_ecef(s1.p_eb_e, s0.p_eb_e);
   std::printf("[stationary 1 h @20 Hz] max horizontal drift %.3e m, final vertical %.3e m\n", max_h, d.z());
   EXPECT_LT(max_h, kTolHorizontal_m);
+  EXPECT_LT(max_h, kMeasuredBoundHorizontal_m);
+  EXPECT_LT(std::abs(d.z()), kMeasuredBoundVertical_m);
   EXPECT_NEAR((s1.t - s0.t), 3600.0, 1e-9);
 }
 
@@ -108,6 +115,8 @@ TEST(Mechanization, SchulerPeriodFromInitialVelocityError) {
               period, period / 60.0, max_n);
   EXPECT_NEAR(period, kSchuler_s, kTolRel * kSchuler_s);
   EXPECT_NEAR(2.0 * crossings[0], kSchuler_s, kTolRel * kSchuler_s);
+  // Amplitude v0/ω_s = v0 T/(2π) with the measured period (measured 2026-12-05: 80.5 m, the theory's value).
+  EXPECT_NEAR(max_n, 0.1 * period / (2.0 * kPi), kTolRel * max_n);
 }
 
 struct RateResult {
@@ -116,9 +125,20 @@ struct RateResult {
 
 TEST(Mechanization, FootMotionAtReducedRatesStaysNearFullRate) {
   // 400 Hz exact IMU of the analytic gait (pitch rate peaks 7 rad/s), 60 s, mechanized at 10/20/50/100 Hz vs
-  // 400 Hz (full rate). Issue 12: 20 Hz within a few centimetres of full rate; all figures reported.
+  // 400 Hz (full rate). Issue 12: 20 Hz within a few centimetres of full rate (kTol20Hz_m, the issue's target).
+  // Measured (2026-12-05, Release): max |dp| vs full 4.55e-6 / 4.50e-6 / 4.52e-6 / 5.19e-6 m at 10 / 20 / 50 /
+  // 100 Hz (the end-point difference is the max), attitude vs full <= 2.9e-13 rad; bound 6.5e-6 m = the largest
+  // +25 % (another libm/compiler). The attitude agrees to round-off at every rate (the increments compose exactly),
+  // so its bound is a round-off bound, 1e-11 rad: a modelling difference would show at 1e-9 rad or more.
+  // End error against the truth 0.2663 m at every rate, full rate included: it is not the mechanization rate but the
+  // samples-to-increments step (point samples of a 7 rad/s rate integrated with an O(Δt²) error per sample: 1.07 /
+  // 0.266 / 0.067 / 0.017 m with 200 / 400 / 800 / 1600 Hz samples, measured 2026-12-05; attitude error 7.2e-5 rad
+  // at 400 Hz tilts gravity into the horizontal). Bound 0.30 m (+13 %, another libm/compiler).
   constexpr double kImuRate_hz = 400.0, kDuration_s = 60.0;
   constexpr double kTol20Hz_m = 0.03;
+  constexpr double kMeasuredBoundVsFull_m = 6.5e-6;
+  constexpr double kRoundOffAtt_rad = 1e-11;
+  constexpr double kMeasuredBoundVsTruth_m = 0.30;
   const FootMotion motion;
   const auto samples = motion.samples(kImuRate_hz, kDuration_s);
   double peak_rate = 0.0;
@@ -135,8 +155,9 @@ TEST(Mechanization, FootMotionAtReducedRatesStaysNearFullRate) {
   };
   const auto full = trace(kImuRate_hz);
   const NavState truth_end = test::nav_from_kinematics(full.back().t, motion.at(full.back().t.seconds()));
-  std::printf("[foot 60 s] full-rate (400 Hz) end error vs truth %.4f m\n",
-              (full.back().p_eb_e - truth_end.p_eb_e).norm());
+  const double full_vs_truth_m = (full.back().p_eb_e - truth_end.p_eb_e).norm();
+  std::printf("[foot 60 s] full-rate (400 Hz) end error vs truth %.4f m\n", full_vs_truth_m);
+  EXPECT_LT(full_vs_truth_m, kMeasuredBoundVsTruth_m);
   std::vector<RateResult> results;
   for (double rate : {10.0, 20.0, 50.0, 100.0}) {
     const auto tr = trace(rate);
@@ -152,7 +173,13 @@ TEST(Mechanization, FootMotionAtReducedRatesStaysNearFullRate) {
     std::printf("[foot 60 s] %5.0f Hz: max |dp| vs full %.2e m, end %.2e m, end vs truth %.4f m, max att %.2e rad\n",
                 rate, r.max_vs_full_m, r.end_vs_full_m, r.end_vs_truth_m, r.max_att_vs_full_rad);
   }
-  for (const auto& r : results) EXPECT_LT(r.max_vs_full_m, kTol20Hz_m) << r.rate_hz << " Hz";
+  for (const auto& r : results) {
+    EXPECT_LT(r.max_vs_full_m, kTol20Hz_m) << r.rate_hz << " Hz";
+    EXPECT_LT(r.max_vs_full_m, kMeasuredBoundVsFull_m) << r.rate_hz << " Hz";
+    EXPECT_LE(r.end_vs_full_m, r.max_vs_full_m) << r.rate_hz << " Hz";  // the end is one of the compared epochs
+    EXPECT_LT(r.end_vs_truth_m, kMeasuredBoundVsTruth_m) << r.rate_hz << " Hz";
+    EXPECT_LT(r.max_att_vs_full_rad, kRoundOffAtt_rad) << r.rate_hz << " Hz";
+  }
 }
 
 }  // namespace

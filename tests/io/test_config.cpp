@@ -144,7 +144,7 @@ TEST(Config, ImuErrorModelDefaultsDependOnTheMode) {
   EXPECT_EQ(tc->bias.model, "auto");
   ImuErrorModelChoice m = imu_error_model_choice(*tc);
   EXPECT_TRUE(m.scale_states);
-  EXPECT_TRUE(m.gyro_scale_states);  // both blocks since session 7 (docs/consistency.md §3.4)
+  EXPECT_TRUE(m.gyro_scale_states);  // both blocks since 2026-12-02 (docs/consistency.md §3.4)
   EXPECT_TRUE(m.bias_random_walk);
   auto tc_acc = parse("mode: tc\n" + files + "scale_factors: {gyro: false}\n");
   ASSERT_TRUE(tc_acc) << tc_acc.error().message;
@@ -200,7 +200,7 @@ TEST(Config, ResolvedConfigurationKeepsImuSpecOverrides) {
 }
 
 // The antenna section: the Doppler rows' velocity model (docs/fusion.md §13), its bad value, and config.resolved.yaml
-// (which did not write the section before session 7) reading back to the same values.
+// (which did not write the section before 2026-12-02) reading back to the same values.
 TEST(Config, ElevationWeightKeyReachesTheEngineOptionsAndRoundTrips) {
   const std::string files = "mode: tc\nrover_obs: r.obs\nnav: n.nav\nimu: {file: i.csv, spec: crista}\n";
   auto def = parse(files);
@@ -234,7 +234,7 @@ TEST(Config, ScaleBiasCompensationKeyReachesTheEngineOptionsAndRoundTrips) {
   const std::string files = "mode: tc\nrover_obs: r.obs\nnav: n.nav\nimu: {file: i.csv, spec: crista}\n";
   auto def = parse(files);
   ASSERT_TRUE(def) << def.error().message;
-  EXPECT_TRUE(engine_options(*def).scale_bias_compensation);  // the default since session 10
+  EXPECT_TRUE(engine_options(*def).scale_bias_compensation);  // the default since 2026-12-02 (docs/consistency.md §3.6)
   auto cfg = parse(files + "scale_factors: {bias_compensation: false}\n");
   ASSERT_TRUE(cfg) << cfg.error().message;
   EXPECT_FALSE(engine_options(*cfg).scale_bias_compensation);

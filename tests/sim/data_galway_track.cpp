@@ -18,19 +18,35 @@
 namespace pednav {
 namespace {
 
-constexpr double kMaxFootToTrackRms_m = 1.5;  // foot under the walker vs the antenna track (half a stride + smoothing)
+// Figures measured 2026-12-05 (Release build); bounds +20 % (kMargin: another libm/compiler) unless said otherwise.
+constexpr double kMargin = 1.20;
+// Foot under the walker vs the antenna track (half a stride + the 1-s Gaussian smoothing of the track): measured
+// 0.85 m RMS over 53414 epochs.
+constexpr double kFootToTrackRms_m = 0.85;
+constexpr int kFootToTrackEpochs = 53414;
 // Tightly coupled run on the real M8P GNSS (issue 5: forward 2D RMS <= 1.5 m, max <= 5 m, 100 % availability against
-// the RTK-fixed GGA epochs; issue 6: smoothed 2D RMS <= 1.0 m). Measured (session 4, default config = multipath
-// Gauss-Markov states on): forward 0.99 / 3.94 m, smoothed 0.86 m.
+// the RTK-fixed GGA epochs; issue 6: smoothed 2D RMS <= 1.0 m). Measured: forward 0.96 m / 4.02 m over 551 epochs,
+// smoothed 0.83 m / 3.79 m.
 constexpr double kMaxForwardRms_m = 1.5;
 constexpr double kMaxForwardMax_m = 5.0;
 constexpr double kMinAvailabilityPct = 100.0 - 1e-9;
 constexpr double kMaxSmoothedRms_m = 1.0;
+constexpr double kForwardRms_m = 0.96, kForwardMax_m = 4.02, kSmoothedRms_m = 0.83, kSmoothedMax_m = 3.79;
+constexpr int kForwardEpochs = 551;
 // Honesty of σ on real signals: share of 1 Hz epochs with |e_N| <= 3σ_N and |e_E| <= 3σ_E against the simulated
-// foot truth (which follows the RTK track). Measured: forward 68.7 %, smoothed 90.5 % with the multipath states;
-// with white code errors (multipath.states: false) 29.9 % / 21.1 %, so these bounds fail without the states.
-constexpr double kMinForwardInside3SigmaPct = 60.0;
-constexpr double kMinSmoothedInside3SigmaPct = 85.0;
+// foot truth. What a consistent filter gives here: if the errors were only those of the filter's model, Gaussian,
+// (0.9973)² = 99.5 % on both axes. But the GNSS signals are the real antenna's, on the GGA track, while the IMU is
+// the synthesized foot, 0.85 m RMS from that track (FootImuAlongTheRealRtkTrack: the stride phase — the foot stands
+// while the walker moves on — and the smoothed track the foot was planned on). The filter's measurement model
+// (antenna = stride-averaged foot + lever arm) does not contain that discrepancy, so a forward solution that follows
+// the GNSS carries it into its foot error while its σ does not: the share falls below 99.5 % by roughly the share of
+// epochs where a discrepancy of that size exceeds the 3σ margin left by the filter's own error. The smoother
+// averages the stride-phase part (zero mean over a stride) out and gets close to the consistent figure. So: forward
+// well below 99.5 %, smoothed near it. Measured: forward 75.0 %, smoothed 98.5 % (with white code errors,
+// multipath.states: false, 29.9 % / 21.1 % when the test was written, so the bounds fail without the states).
+// Bounds on the share OUTSIDE 3σ, measured +20 %: forward 25.0 % -> 30 %, smoothed 1.5 % -> 1.8 %.
+constexpr double kMinForwardInside3SigmaPct = 100.0 - kMargin * 25.0;
+constexpr double kMinSmoothedInside3SigmaPct = 100.0 - kMargin * 1.5;
 
 TEST(GalwayTrack, FootImuAlongTheRealRtkTrack) {
   const std::string nmea = test::shared_data("gnss_ublox_m8p_walk_galway/reference_nmea/rover-20181004-1532.nmea");
@@ -61,8 +77,8 @@ TEST(GalwayTrack, FootImuAlongTheRealRtkTrack) {
   ASSERT_TRUE(ev.has_value()) << (ev ? "" : ev.error().message);
   std::printf("galway_track: foot truth vs RTK-fixed GGA: %d epochs, horizontal RMS %.2f m\n", ev->epochs_compared,
               ev->horizontal_rms_m);
-  EXPECT_GT(ev->epochs_compared, 20000);
-  EXPECT_LT(ev->horizontal_rms_m, kMaxFootToTrackRms_m);
+  EXPECT_NEAR(ev->epochs_compared, kFootToTrackEpochs, 0.01 * kFootToTrackEpochs);
+  EXPECT_LT(ev->horizontal_rms_m, kMargin * kFootToTrackRms_m);
 }
 
 TEST(GalwayTrack, TightlyCoupledOnTheRealGnssAgainstRtkFixed) {
@@ -115,6 +131,11 @@ TEST(GalwayTrack, TightlyCoupledOnTheRealGnssAgainstRtkFixed) {
   EXPECT_LE(fwd->horizontal_max_m, kMaxForwardMax_m);
   EXPECT_GE(fwd->availability_pct, kMinAvailabilityPct);
   EXPECT_LE(smo->horizontal_rms_m, kMaxSmoothedRms_m);
+  EXPECT_NEAR(fwd->epochs_compared, kForwardEpochs, 0.01 * kForwardEpochs);
+  EXPECT_LT(fwd->horizontal_rms_m, kMargin * kForwardRms_m);
+  EXPECT_LT(fwd->horizontal_max_m, kMargin * kForwardMax_m);
+  EXPECT_LT(smo->horizontal_rms_m, kMargin * kSmoothedRms_m);
+  EXPECT_LT(smo->horizontal_max_m, kMargin * kSmoothedMax_m);
   EXPECT_GE(in_f, kMinForwardInside3SigmaPct);
   EXPECT_GE(in_s, kMinSmoothedInside3SigmaPct);
 }
