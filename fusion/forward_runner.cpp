@@ -266,6 +266,12 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
     integrator.push(corrected, on_increment);
     if (failed) break;
   }
+  // The data ended inside a mechanization interval: that partial interval (up to the last sample) is one more step,
+  // so the solution reaches the last sample (without it the last up to 1/rate s of every log were dropped).
+  if (sample_index == samples.size() && !failed && !waiting) {
+    ins::ImuIncrement last;
+    if (integrator.flush(last)) on_increment(last);
+  }
   if (pending) count_outcome(sum.gnss_skipped, "filter_diverged", pending->n_sats);
   sum.imu_estimate = f.imu_estimate();
   if (gnss_pass) {
