@@ -20,12 +20,7 @@ void add_batch_command(CLI::App& app, Action& action) {
   cmd->add_option("--shard", *shard, "K/N: only the items with index mod N = K-1 (docs/scale.md)");
   cmd->callback([&action, manifest, out, shard] {
     int k = 1, n = 1;
-    if (!shard->empty()) {
-      char slash = 0;
-      std::istringstream in(*shard);
-      if (!(in >> k >> slash >> n) || slash != '/' || !in.eof() || n < 1 || k < 1 || k > n)
-        throw CLI::ValidationError("--shard", "expected K/N with 1 <= K <= N, got '" + *shard + "'");
-    }
+    if (!shard->empty()) parse_shard(*shard, k, n);
     action = [manifest, out, k, n] {
       auto r = pipeline::run_batch_command(*manifest, *out, k, n);
       if (!r) {

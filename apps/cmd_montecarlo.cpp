@@ -80,15 +80,7 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
                   "K/N: run only this share of the seeds (runs i with i mod N = K-1) into OUT/runs and OUT/shard.json, "
                   "for a cluster; combine the N folders with pednav montecarlo-merge (docs/scale.md)");
   cmd->callback([&action, mo, shard] {
-    if (!shard->empty()) {
-      int k = 0, n = 0;
-      char slash = 0;
-      std::istringstream in(*shard);
-      if (!(in >> k >> slash >> n) || slash != '/' || !in.eof() || n < 1 || k < 1 || k > n)
-        throw CLI::ValidationError("--shard", "expected K/N with 1 <= K <= N, got '" + *shard + "'");
-      mo->shard_index = k;
-      mo->shard_count = n;
-    }
+    if (!shard->empty()) parse_shard(*shard, mo->shard_index, mo->shard_count);
     action = [mo] {
       if (auto ok = pipeline::run_montecarlo_command(*mo); !ok) {
         spdlog::error("{}", ok.error().message);

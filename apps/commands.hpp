@@ -3,6 +3,8 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <sstream>
+#include <string>
 
 namespace pednav::apps {
 
@@ -23,5 +25,13 @@ void add_outage_command(CLI::App& app, Action& action);
 void add_report_command(CLI::App& app, Action& action);
 void add_zupt_command(CLI::App& app, Action& action);
 void add_hmm_train_command(CLI::App& app, Action& action);
+
+/// `--shard K/N` (montecarlo, batch): K and N, 1 <= K <= N; a CLI11 validation error naming the option otherwise.
+inline void parse_shard(const std::string& text, int& k, int& n) {
+  char slash = 0;
+  std::istringstream in(text);
+  if (!(in >> k >> slash >> n) || slash != '/' || !in.eof() || n < 1 || k < 1 || k > n)
+    throw CLI::ValidationError("--shard", "expected K/N with 1 <= K <= N, got '" + text + "'");
+}
 
 }  // namespace pednav::apps

@@ -78,6 +78,11 @@ namespace {
 struct Ellipse {
   double major_m = 0.0, minor_m = 0.0, orientation_deg = 0.0;  // 1σ semi-axes, major axis clockwise from north
 };
+
+// The per-epoch values both map formats carry: position and σ.
+struct EpochMapValues {
+  double lon_deg, lat_deg, h_m, sd_n_m, sd_e_m, sd_d_m;
+};
 Ellipse horizontal_ellipse(const Eigen::Matrix3d& cov_n) {
   const Eigen::Matrix2d c = cov_n.topLeftCorner<2, 2>();  // N, E
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(c);
@@ -90,6 +95,12 @@ Ellipse horizontal_ellipse(const Eigen::Matrix3d& cov_n) {
   if (az >= 180.0) az -= 180.0;
   e.orientation_deg = az;
   return e;
+}
+
+EpochMapValues map_values(const SolutionRow& r) {
+  const Geodetic g = geodetic_from_ecef(r.p_e);
+  return {g.lon * kRadToDeg, g.lat * kRadToDeg, g.h_m, std::sqrt(std::max(0.0, r.cov_p_n(0, 0))),
+          std::sqrt(std::max(0.0, r.cov_p_n(1, 1))), std::sqrt(std::max(0.0, r.cov_p_n(2, 2)))};
 }
 
 std::string utc_iso(GpsTime t) {
@@ -137,17 +148,15 @@ Expected<void> write_solution_geojson(const std::string& path, const std::vector
   }
   o += "]}}";
   for (const SolutionRow& r : rows) {
-    const Geodetic g = geodetic_from_ecef(r.p_e);
+    const EpochMapValues v = map_values(r);
     const Ellipse e = horizontal_ellipse(r.cov_p_n);
     o += fmt::format(
         ",\n{{\"type\": \"Feature\", \"geometry\": {{\"type\": \"Point\", \"coordinates\": [{:.9f}, {:.9f}, {:.4f}]}}, "
         "\"properties\": {{\"gps_week\": {}, \"gps_tow_s\": {:.3f}, \"utc\": \"{}\", \"sd_n_m\": {:.4f}, \"sd_e_m\": {:.4f}, "
         "\"sd_d_m\": {:.4f}, \"sigma_major_m\": {:.4f}, \"sigma_minor_m\": {:.4f}, \"orientation_deg\": {:.2f}, "
         "\"n_sats_used\": {}, \"zupt\": {}}}}}",
-        g.lon * kRadToDeg, g.lat * kRadToDeg, g.h_m, r.time.week(), r.time.tow_s(), utc_iso(r.time),
-        std::sqrt(std::max(0.0, r.cov_p_n(0, 0))), std::sqrt(std::max(0.0, r.cov_p_n(1, 1))),
-        std::sqrt(std::max(0.0, r.cov_p_n(2, 2))), e.major_m, e.minor_m, e.orientation_deg, r.n_sats_used,
-        r.zupt ? (*r.zupt ? "true" : "false") : "null");
+        v.lon_deg, v.lat_deg, v.h_m, r.time.week(), r.time.tow_s(), utc_iso(r.time), v.sd_n_m, v.sd_e_m, v.sd_d_m,
+        e.major_m, e.minor_m, e.orientation_deg, r.n_sats_used, r.zupt ? (*r.zupt ? "true" : "false") : "null");
   }
   o += "\n]}\n";
   return write_file_atomic(path, o);
@@ -166,7 +175,7 @@ Expected<void> write_solution_kml(const std::string& path, const std::vector<Sol
   }
   o += "</coordinates></LineString></Placemark>\n<Folder><name>epochs</name>\n";
   for (const SolutionRow& r : rows) {
-    const Geodetic g = geodetic_from_ecef(r.p_e);
+    const EpochMapValues v = map_values(r);
     const Ellipse e = horizontal_ellipse(r.cov_p_n);
     o += fmt::format(
         "<Placemark><name>{:.3f}</name><styleUrl>#epoch</styleUrl><TimeStamp><when>{}</when></TimeStamp>"
@@ -176,9 +185,8 @@ Expected<void> write_solution_kml(const std::string& path, const std::vector<Sol
         "<Data name=\"sigma_minor_m\"><value>{:.4f}</value></Data><Data name=\"orientation_deg\"><value>{:.2f}</value></Data>"
         "<Data name=\"n_sats_used\"><value>{}</value></Data></ExtendedData>"
         "<Point><coordinates>{:.9f},{:.9f},{:.4f}</coordinates></Point></Placemark>\n",
-        r.time.tow_s(), utc_iso(r.time), r.time.week(), r.time.tow_s(), std::sqrt(std::max(0.0, r.cov_p_n(0, 0))),
-        std::sqrt(std::max(0.0, r.cov_p_n(1, 1))), std::sqrt(std::max(0.0, r.cov_p_n(2, 2))), e.major_m, e.minor_m,
-        e.orientation_deg, r.n_sats_used, g.lon * kRadToDeg, g.lat * kRadToDeg, g.h_m);
+        r.time.tow_s(), utc_iso(r.time), r.time.week(), r.time.tow_s(), v.sd_n_m, v.sd_e_m, v.sd_d_m, e.major_m,
+        e.minor_m, e.orientation_deg, r.n_sats_used, v.lon_deg, v.lat_deg, v.h_m);
   }
   o += "</Folder>\n</Document>\n</kml>\n";
   return write_file_atomic(path, o);
