@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav batch MANIFEST -o OUT [--shard K/N]`: the work is pipeline::run_batch_command.
 #include <spdlog/spdlog.h>
 

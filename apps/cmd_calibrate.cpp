@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav calibrate CONFIG.yaml -o OUT`: the work is pipeline::run_calibrate_command.
 #include <spdlog/spdlog.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav compare SOLUTION REFERENCE -o OUT`.
 #include <spdlog/spdlog.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav gnss CONFIG.yaml -o OUT`: thin registration; the work is pipeline::run_gnss_command.
 #include <spdlog/spdlog.h>
 

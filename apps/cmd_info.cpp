@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav config-check` and `pednav rinex-info`: inspect inputs before a run.
 #include <spdlog/spdlog.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav montecarlo SCENARIO.yaml --runs N -o OUT`: the flags; the study is pipeline/montecarlo_command.
 #include <spdlog/spdlog.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav outage CONFIG.yaml -o OUT`: GNSS outage study (pipeline/outage_command.hpp).
 #include <spdlog/spdlog.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav report OUTDIR`: one self-contained report.html of a run folder (io/report.hpp).
 #include <spdlog/spdlog.h>
 

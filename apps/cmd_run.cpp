@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav run CONFIG.yaml -o OUT`.
 #include <spdlog/spdlog.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav simulate SCENARIO.yaml -o OUT`: thin registration; the work is pipeline::run_simulate_command.
 #include <spdlog/spdlog.h>
 

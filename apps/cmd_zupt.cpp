@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav zupt CONFIG.yaml -o OUT` and `pednav hmm-train CONFIG.yaml... -o hmm.yaml`: thin registrations; the work
 // is pipeline::run_zupt_command / pipeline::run_hmm_train_command.
 #include <spdlog/spdlog.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Each subcommand registers itself on the CLI11 app; its work is done by a function in pipeline/ (testable).
 #pragma once
 

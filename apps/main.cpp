@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // pednav command-line front end: parses arguments, sets up logging, dispatches to one subcommand.
 #include <spdlog/spdlog.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Benchmarks of the fusion hot paths (issue 10): covariance prediction of one mechanization step, a ZUPT (+ZARU)
 // update, an SD pseudorange + Doppler update with 10 satellites, one smoother step (the earlier per-step backward
 // map, and the interval bookkeeping the engine runs now), and reading a RINEX

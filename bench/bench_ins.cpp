@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Benchmarks of the INS hot paths (issue 12): one mechanization step, increment integration per IMU sample,
 // the error-model discretization, and the IMU CSV parser (lines per second).
 #include <benchmark/benchmark.h>

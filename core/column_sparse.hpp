@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Products with small matrices that are mostly zeros (the INS error model's F, G and Φ: 60-80 % zeros), skipping the
 // zeros. Storage is inline (no heap allocation): up to kMaxDim x kMaxDim. Used on the per-step path of the filter
 // (docs/performance.md).

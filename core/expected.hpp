@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Expected<T> / Error: the return type of every fallible function (files, config, data problems).
 #pragma once
 

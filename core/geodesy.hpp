@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // WGS84 geodesy: ECEF <-> geodetic, the NED frame at a point, local offsets.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Rotations: Hamilton quaternions, rotation matrices, SO(3) exp/log, skew, Euler angles (I/O only).
 // Convention (docs/conventions.md): R_a_b maps b-resolved vectors into a: v_a = R_a_b * v_b.
 #pragma once

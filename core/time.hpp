@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // GPS time: integer nanoseconds since the GPS epoch (1980-01-06 00:00:00 GPST), exposed as week + seconds.
 #pragma once
 

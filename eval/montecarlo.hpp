@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Monte Carlo consistency of a navigation filter (seed 000, issue 9): per output epoch across M seeded runs the
 // mean error, the sample σ of the error, the mean filter σ (√P), the average NEES with its two-sided 95 % χ² band,
 // and the RMS error vs distance travelled. Pure aggregation: no I/O (pipeline/montecarlo_command.cpp reads and writes).

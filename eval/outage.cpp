@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "eval/outage.hpp"
 
 #include <algorithm>

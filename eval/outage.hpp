@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // GNSS outage studies (seed 004 section "GPS/INS/ZUPTs integrated results", Figures 14-17): placement of the
 // outage windows, which satellites a partial outage keeps, and the aggregation of the per-window position errors
 // into the error as a function of time since the outage started (RMS across windows, seed 004 Figure 17).

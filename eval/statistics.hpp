@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Statistics of matched position errors beyond eval/trajectory.hpp: per-segment figures (the run cut into
 // consecutive time segments) and vertical figures. Pure functions: no I/O.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Trajectories and their comparison against a reference: errors in ENU at the reference, the statistics of
 // DESIGN.md's evaluation.json (seed 004 Tables 1-2 bins), loop closure, and optional alignment for references
 // in a local frame (e.g. Vicon).

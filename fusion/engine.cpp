@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The engine's entry point (fusion/engine.hpp): checks the inputs, runs the stance detector, initializes (the first
 // still period levels the IMU and may give the gyro bias; position from the configuration or the first GNSS epoch
 // solution; heading from the configuration or from motion) and runs the forward pass with the smoother. The parts:

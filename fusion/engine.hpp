@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The forward engine: closed-loop error-state EKF over one time-ordered stream of IMU samples and GNSS epochs.
 // Mechanization + covariance prediction at the configured rate, ZUPT (form D or F) during detected stance,
 // single-differenced (or undifferenced) pseudorange and Doppler updates with innovation-based fault rejection.

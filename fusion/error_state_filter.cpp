@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The engine's filter (fusion/error_state_filter.hpp): propagation, feedback, restarts, health, compensation totals.
 #include "fusion/error_state_filter.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The engine's filter: the nominal INS state with the differential receiver clocks, and the covariance of its error
 // state. Propagation (Φ, Q_d at the mechanization rate, clocks and multipath Gauss-Markov slots), the Joseph-form
 // update with closed-loop feedback, restarts of single states (clock jumps, multipath slots), the health check, the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Fault detection of the GNSS rows (fusion/fault_detection.hpp): the persistent-fault history per satellite.
 #include "fusion/fault_detection.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Fault detection of the GNSS rows of one epoch (docs/fusion.md §6): the iterative Baarda w-test, worst row first,
 // against the χ²(1) quantile of the configured probability, and the persistent-fault test over a satellite's
 // consecutive epochs (§6.2, eq. 6.5). Each rejection is counted by reason in the summary; a rejected row is data,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The forward pass (fusion/forward_runner.hpp).
 #include "fusion/forward_runner.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The forward pass of the engine: one time-ordered walk over the IMU samples (saturation repair, bias correction,
 // increments at the mechanization rate) that sequences, at each step, the prediction, the ZUPT/ZARU and step updates
 // (fusion/stance_updates), the GNSS epochs due (fusion/gnss_update), the health check with re-initialization from a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The GNSS measurement update of one rover epoch (fusion/gnss_update.hpp).
 #include "fusion/gnss_update.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The GNSS measurement update of one rover epoch (docs/fusion.md §3, §6, §13, §14): base epoch matching (or the
 // epoch processed undifferenced when the base stopped), single-differenced (or undifferenced) pseudorange and
 // Doppler rows with their Jacobians and C/N0–elevation weights, the code multipath slots, the clock and drift

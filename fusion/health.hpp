@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Covariance health check of the forward engine (docs/robustness.md "Filter health"): a covariance that lost its
 // symmetry or positive semi-definiteness means the filter's idea of its own accuracy is broken (divergence), even
 // while the state still looks plausible. Fixed-capacity matrices: nothing is allocated.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Initialization of the engine's state (fusion/initialization.hpp).
 #include "fusion/initialization.hpp"
 

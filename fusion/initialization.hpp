@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Initialization of the engine's state (docs/fusion.md §8, docs/ins.md §6): the first still period (the levelling
 // window), the initial gyro bias from its mean rate when that is consistent with the turn-on prior (eq. 6.1), and the
 // heading from motion — an INS/ZUPT pass with yaw 0 fitted to the GNSS epoch solutions at growing walked distances.

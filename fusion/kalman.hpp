@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The EKF covariance prediction and Joseph-form update of the forward engine on fixed-capacity matrices
 // (ins::ErrorMatrix: sized at run time, stored inline): no heap allocation when the measurement matrices have a
 // fixed capacity too (docs/performance.md). Used by fusion/error_state_filter and the benchmarks in bench/.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // IMU (foot) -> GNSS antenna (body) lever arm of the tightly coupled filter (docs/fusion.md §14).
 //
 // A backpack antenna is not rigidly attached to a foot IMU: the filter carries the offset's walking variation as

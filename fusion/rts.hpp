@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Rauch-Tung-Striebel smoothing of a closed-loop (feedback) error-state filter, as pure linear algebra: no INS,
 // no I/O. Between two output epochs a < b the forward filter feeds its own events (prediction, updates with their
 // gains, re-expressions, state resets) into RtsInterval, which carries the cross-covariance of the error at a with

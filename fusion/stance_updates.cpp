@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // ZUPT, ZARU and step-velocity updates (fusion/stance_updates.hpp).
 #include "fusion/stance_updates.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The updates of a foot at rest and of its steps: the ZUPT in form D or F (docs/fusion.md §4, seed 001 eq. 8-9) with
 // the re-expression of the covariance at the new velocity (eq. 5.9), the zero angular-rate update (ZARU) over an
 // all-stance interval with its optional innovation gate (§5.3), and the seed 000 step-averaged velocity update.

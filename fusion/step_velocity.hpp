@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Step-averaged velocity aiding from a biomechanical step-length model (seed 000, issue 9).
 //
 // Seed 000: the pedestrian moves like an inverted pendulum of length l; the rise h of the centre of mass over the

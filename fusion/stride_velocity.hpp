@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Stride-average velocity of the IMU foot: the predicted velocity of a body-worn GNSS antenna (docs/fusion.md §13).
 //
 // A foot-mounted IMU stands still for a third of each gait cycle and swings at 1.5–2.5× the walking speed for the

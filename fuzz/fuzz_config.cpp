@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // libFuzzer target: run configuration and scenario YAML (io/yaml_schema, io/config, io/scenario_config).
 // Input: byte 0 selects run config (even) or scenario (odd), the rest is the YAML text. Any input must give a
 // configuration or an error, never a crash or a hang; an accepted run configuration must round-trip through

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // libFuzzer target: IMU CSV reader (io/imu_csv) with each built-in preset and two inline column maps.
 // Input: byte 0 selects the format, the rest is the CSV text. Any input must give a log or an error, never a
 // crash, a hang or a non-finite sample.

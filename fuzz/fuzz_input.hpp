@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Helpers of the libFuzzer targets: the first input byte selects a variant, the rest is the file content;
 // readers that take a path get it through an anonymous in-memory file (memfd, /proc/self/fd/N).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // libFuzzer target: RINEX observation and navigation files through pednav's RTKLIB adapter (gnss/rtklib/rinex).
 // Input: byte 0 selects obs (even) or nav (odd), the rest is the file content. In the fuzz build RTKLIB's RINEX
 // parser is compiled from Debian's source with the same instrumentation (fuzz/CMakeLists.txt), so memory errors

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // libFuzzer target: reference trajectory readers (io/trajectory_io): NMEA GGA, RTKLIB .pos, CSV, auto-detection.
 // Input: byte 0 selects the reader, the rest is the file content. Any input must give a trajectory or an error
 // naming the file, never a crash or a hang; an accepted trajectory has finite points in strictly increasing time.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "gnss/code_smoothing.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Doppler-smoothed pseudoranges (a Hatch filter with the integrated Doppler in place of the carrier phase) for the
 // epoch-by-epoch GNSS solution. docs/gnss.md "Doppler smoothing of the code". The carrier phase is not needed, so a loss of lock (LLI) does not
 // restart the filter; a data gap, a missing Doppler or a code jump does.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Broadcast-ephemeris satellite states. Equations: IS-GPS-200N Table 20-IV (position, clock, relativistic
 // term), its velocity derivative (Remondi 2004, "Computing satellite velocity using the broadcast ephemeris"),
 // BDS-SIS-ICD 2.0 §5.2.4.12 (GEO), GLONASS ICD 5.1 Appendix J.1 (state-vector integration).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Satellite position, velocity, clock bias and clock drift from broadcast ephemerides (pure maths, no RTKLIB).
 // GPS/QZSS/Galileo/BeiDou: Keplerian elements, IS-GPS-200 Table 20-IV (+ analytic velocity), BeiDou GEO
 // rotation (BDS-SIS-ICD 2.0 §5.2.4.12). GLONASS: RK4 integration of the PZ-90 state vector (GLONASS ICD 5.1

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Rover/base epoch matching; see gnss/epoch_matching.hpp.
 #include "gnss/epoch_matching.hpp"
 

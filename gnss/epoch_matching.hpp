@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Rover/base epoch matching for single differencing (pure: works on time tags only).
 #pragma once
 

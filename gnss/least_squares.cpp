@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Epoch least squares with FDE; see gnss/least_squares.hpp and docs/gnss.md ("Epoch solver").
 #include "gnss/least_squares.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Epoch-by-epoch weighted least squares: position + one receiver clock per constellation from code, then
 // velocity + clock drift from Doppler, each with fault detection and exclusion (global chi-square test, then
 // worst normalized residual first while redundancy allows). Single-differenced (rover - base) when a base

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Measurement models: see gnss/measurement.hpp and docs/gnss.md ("Measurement models").
 #include "gnss/measurement.hpp"
 

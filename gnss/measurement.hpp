@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // GNSS code and Doppler measurement models (undifferenced and single-differenced rover - base) with Jacobians
 // w.r.t. the rover antenna position/velocity and the receiver clock/drift. Shared by the epoch least squares
 // (gnss/least_squares.*) and the tightly coupled EKF (fusion/). Model and sign conventions: docs/gnss.md.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Project-side GNSS types: satellites, observations, broadcast ephemerides. No RTKLIB types leak out.
 #pragma once
 

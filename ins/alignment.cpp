@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Coarse alignment (docs/ins.md §6). At rest f_ib_b = -R_b_n g_n with g_n = (0, 0, g), so
 // roll = atan2(-f_y, -f_z), pitch = atan2(f_x, sqrt(f_y^2 + f_z^2)) (Groves 2013 §5.6.2, eq. 5.101 form).
 #include "ins/alignment.hpp"

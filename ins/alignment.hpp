@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Initial alignment: stillness check, coarse levelling (roll, pitch) and gyro bias from a stationary period,
 // heading from configuration, magnetometer or later GNSS (docs/ins.md §6; Groves 2013 §5.6.2).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Self-calibration of an IMU log (ins/calibration.hpp, docs/ins.md §10).
 #include "ins/calibration.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Self-calibration of an IMU log (docs/ins.md §10): what a log says about its own sensor and gait, with no prior
 // from a data sheet. Still periods are found by a variance test against the log's own noise floor; from them come
 // the gyro bias at the start, the white-noise densities (ARW, VRW) and the gravity direction in the sensor frame

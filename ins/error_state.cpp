@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Error-state model (docs/error_state.md). State order: δp_e [0,3), δv_e [3,6), φ_e [6,9), δb_g [9,12),
 // δb_a [12,15), then registered optional blocks. Noise order: n_g, n_a, w_bg, w_ba, (w_sg), (w_sa).
 #include "ins/error_state.hpp"

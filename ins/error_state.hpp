@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Error-state layout, boxplus/boxminus, and the continuous/discrete INS error model (15 core states +
 // optional blocks). The definition of the error state is docs/error_state.md (cite it, do not restate it):
 //   x_true = x_est ⊞ δx:  p_true = p_est + δp,  v_true = v_est + δv,  R_e_b_true = exp([φ×]) R_e_b_est,

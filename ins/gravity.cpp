@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "ins/gravity.hpp"
 
 #include "core/geodesy.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // WGS84 gravity in ECEF: J2 gravitation (Groves 2013 eq. 2.142) plus the centrifugal term (Groves 2013 §2.4.7).
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Discrete hidden Markov model of the gait cycle (seed 002 §3): 4 states (push-off A, swing B, heel strike C,
 // stance D), 15 observation symbols (quantized extreme values of the gyro rate about the axis across the foot),
 // scaled forward-backward, Baum-Welch re-estimation (seed 002 eq. 3-4, discrete form of eq. 5-7; Rabiner 1989

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Increment integration (docs/ins.md §2): two-speed structure of Savage 1998 (Parts 1-2) with the body-frame
 // rotation/velocity/position increments composed at the IMU rate; coning and sculling terms per sub-interval
 // (Groves 2013 §5.5.4).

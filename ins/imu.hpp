@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // IMU samples and their integration into coning/sculling-compensated increments over mechanization intervals.
 // Model and equations: docs/ins.md §2 (Savage 1998 Parts 1-2; Groves 2013 §5.5.4).
 #pragma once

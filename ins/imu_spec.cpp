@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // IMU spec presets. Sources and conversions: docs/ins.md §5 (which values are datasheet figures and which are
 // assumptions is stated there, per value).
 #include "ins/imu_spec.hpp"

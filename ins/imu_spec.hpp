@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // IMU noise and error specification (SI inside) and named presets (docs/ins.md §5 cites the datasheets).
 #pragma once
 

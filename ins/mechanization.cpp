@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Precise ECEF mechanization (docs/ins.md §3), Groves 2013 §5.2 with the precision forms of §5.5.1-5.5.3.
 // Inputs are the body-frame increments of the interval (C(t) = R_b(t0)_b(t)): Δθ = log C(t1), V = ∫ C f dt,
 // P = ∫∫ C f (identity: ∫ t C f dt = V Δt - P). Order of one step:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Precise ECEF strapdown mechanization over one increment interval (docs/ins.md §3; Groves 2013 §5.2 and §5.5).
 #pragma once
 

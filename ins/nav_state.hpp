@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The nominal (whole-state) INS navigation solution in ECEF.
 #pragma once
 

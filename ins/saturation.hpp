@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Saturated (clipped) IMU samples: find the runs of samples held at the full scale, reconstruct the clipped part
 // from the samples around each run, and say how uncertain the reconstruction is (docs/ins.md §9).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Zero-velocity (stance) detectors for a foot-mounted IMU (SHOE, ARE, MAG, moving variance, HMM), run offline over
 // a whole log (post-processing: windows are centred on the sample they decide). docs/zupt.md.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Outputs are written to a temporary name in the target folder and renamed when complete, so a file with the
 // final name is never half-written (a crash or a kill leaves only "<name>.tmp.<pid>").
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "io/config.hpp"
 
 #include <yaml-cpp/yaml.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Run configuration: YAML -> validated options (SI inside; non-SI YAML keys carry their unit suffix).
 // The YAML vocabulary is documented in README.md ("Configuration"). Sections live in io/config_<section>.cpp.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // YAML section reader: filter options (mechanization rate, ZUPT, fault rejection, smoother).
 #include "core/geodesy.hpp"
 #include "fusion/engine.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // YAML section reader: GNSS files (top level) and the `gnss:` options.
 #include "io/config.hpp"
 #include "io/yaml_schema.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "io/hmm_model_io.hpp"
 
 #include <yaml-cpp/yaml.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // IMU CSV reader: one pass over the bytes with std::from_chars (no iostreams per field), then the checks.
 #include "io/imu_csv.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Built-in IMU format presets. The text is identical to datasets/imu_formats/<name>.yaml (a test checks it).
 #include "io/imu_csv.hpp"
 

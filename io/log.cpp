@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "io/log.hpp"
 
 #include <spdlog/sinks/basic_file_sink.h>

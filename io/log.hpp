@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Logging setup (spdlog) and a progress display on stderr. Only io/ and apps/ log.
 #pragma once
 

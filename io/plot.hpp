@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Plots as SVG through gnuplot (Debian package gnuplot-nox, run as a subprocess; scripts/setup installs it).
 // A plot is described as data (PlotSpec); gnuplot_script() turns it into a gnuplot script with inline data blocks
 // and render_svg() runs gnuplot on it. Nothing here draws by hand.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "io/plot_figures.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The standard figures of pednav (compare, report, outage) as PlotSpecs for io/plot.hpp: trajectory against the
 // reference in local East/North, error vs time with the +-3 sigma envelope, error CDF, satellites used/rejected,
 // ZUPT timeline, outage RMS vs time since the outage started, Monte Carlo consistency (seed 000 Figs. 4-6).

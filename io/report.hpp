@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav report OUTDIR`: one self-contained report.html (tables + plots embedded as SVG data URIs, readable
 // offline) of a run directory (pednav run / gnss outputs) and of any outage study found in it or its subfolders.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // residuals.csv of `pednav run` (tc mode): one row per GNSS measurement tested by the forward filter's w-test.
 #pragma once
 

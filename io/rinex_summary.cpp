@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "io/rinex_summary.hpp"
 
 #include <fmt/format.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Human-readable summary of a RINEX observation file (pednav rinex-info).
 #pragma once
 

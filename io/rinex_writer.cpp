@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // RINEX 3.04 writers (format description RINEX 3.04, Tables A1-A6). Fixed-width fields; header labels in
 // columns 61-80.
 #include "io/rinex_writer.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // RINEX 3.04 writers: GPS observation files (C1C, D1C, S1C) and GPS navigation files (RINEX 3.04 §A.4,
 // Tables A3 and A6 of the RINEX 3.04 format description, IGS/RTCM 2018). Written atomically.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Scenario YAML reader (README "Scenario files (pednav simulate)"). Unit-suffixed keys are converted to SI here.
 #include "io/scenario_config.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Simulator scenario files (YAML) -> sim::Scenario, strict (unknown keys, wrong types, out-of-range values are
 // errors, all reported at once). Keys: README "Scenario files (pednav simulate)".
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Solution writers; see io/solution_writer.hpp.
 #include "io/solution_writer.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Solution writers shared by `pednav gnss` and `pednav run`: solution.csv columns of DESIGN.md and the
 // RTKLIB solution format (.pos, lat/lon/height, readable by rtkplot). Written through io/atomic_file.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Trajectory readers for evaluation: NMEA GGA, RTKLIB .pos, CSV (pednav solution/truth columns and others).
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Strict YAML mapping reader: every problem (unknown key, wrong type, missing key, out of range) is collected
 // with its file:line and YAML path, so a config is rejected with all of its problems at once.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav batch` (pipeline/batch_command.hpp).
 #include "pipeline/batch_command.hpp"
 

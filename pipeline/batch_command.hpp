@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav batch MANIFEST -o OUT [--shard K/N]` (docs/scale.md): many configurations of a field campaign, each run by
 // its command (run, gnss, outage) into OUT/<name>/; an index of successes and failures with the error line; resumable
 // (an item whose OUT/<name>/batch_status.json says ok is not redone); one summary table (accuracy per log when the

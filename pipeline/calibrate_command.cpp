@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav calibrate` (pipeline/calibrate_command.hpp).
 #include "pipeline/calibrate_command.hpp"
 

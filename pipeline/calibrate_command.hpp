@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav calibrate CONFIG.yaml -o OUT` (docs/ins.md §10): the IMU log of a configuration (imu.file, imu.format)
 // calibrates itself — still periods, gyro bias, noise densities, gravity axis, rate and jitter, saturation, gait —
 // into calibration.json, and calibration.yaml: the `imu.spec` mapping and the SHOE threshold that `imu.spec: auto`

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav gnss`: read rover/base/nav, match epochs, solve each epoch, write gnss.csv, gnss.pos, summary.json.
 #include "pipeline/gnss_command.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav gnss CONFIG.yaml -o OUT`: GNSS-only epoch-by-epoch least squares (SD with a base, else undifferenced)
 // -> gnss.csv, gnss.pos, summary.json (all written atomically).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav montecarlo` (pipeline/montecarlo_command.hpp).
 #include "pipeline/montecarlo_command.hpp"
 

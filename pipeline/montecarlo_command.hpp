@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav montecarlo SCENARIO.yaml --runs N -o OUT`: N seeded simulate + run pairs (issue 9, seed 000), in parallel
 // on all cores. Each run is simulated in memory (sim::simulate) and processed by the engine in memory
 // (fusion::run_forward): no RTKLIB call is made, so the runs are independent and thread-safe. Each finished run is

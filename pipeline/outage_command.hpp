@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav outage CONFIG.yaml -o OUT`: GNSS outage study (seed 004 Figures 14-17). One run without outage, then
 // one run per window with the GNSS mask applied (full outage, or partial: keep N satellites, dropping the lowest
 // elevation - or weakest C/N0 - satellite while more than N remain). Errors against the configured reference, else

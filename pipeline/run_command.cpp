@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "pipeline/run_command.hpp"
 
 #include <fmt/format.h>

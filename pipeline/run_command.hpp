@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav run CONFIG.yaml -o OUT`: the forward tightly coupled (or INS/ZUPT-only) filter -> solution.csv,
 // solution.pos, summary.json, config.resolved.yaml, and evaluation.json when a reference is configured; with
 // smoother.enabled also the RTS smoothed smoothed.csv, solution_smoothed.pos and evaluation_smoothed.json.

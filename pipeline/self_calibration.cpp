@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `auto` IMU spec and SHOE threshold from the log (pipeline/self_calibration.hpp).
 #include "pipeline/self_calibration.hpp"
 

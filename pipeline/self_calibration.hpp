@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `imu.spec: auto` and `zupt.shoe_threshold: auto` (docs/ins.md §10, docs/zupt.md §6): the log calibrates itself
 // before a run (ins::calibrate_imu), and the configuration gets the IMU model and the SHOE threshold the log shows.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav simulate` outputs (docs/sim.md §7): the simulator's data formatted and written atomically.
 #include "pipeline/simulate_command.hpp"
 

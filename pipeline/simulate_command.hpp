@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav simulate SCENARIO.yaml -o OUT`: runs the simulator and writes truth.csv, imu.csv, rover.obs,
 // base.obs, nav.rnx, blunders.csv, config.yaml and config_datasheet.yaml (each atomically). File formats:
 // docs/sim.md §7.

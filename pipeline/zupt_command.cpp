@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "pipeline/zupt_command.hpp"
 
 #include "pipeline/self_calibration.hpp"

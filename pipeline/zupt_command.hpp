@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav zupt CONFIG.yaml -o OUT` (run the configured zero-velocity detector over the IMU log: zupt.csv,
 // summary.json, zupt.svg) and `pednav hmm-train CONFIG.yaml... -o hmm.yaml` (Baum-Welch over one or more logs).
 #pragma once

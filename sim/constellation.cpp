@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Nominal GPS constellation (docs/sim.md §5). Slot table: SPS Performance Standard (2008) Table 3.1-1
 // (RAAN of planes A-F and argument of latitude of the 24 baseline slots at the reference epoch), used here
 // as relative geometry at the start of the scenario's GPS week.

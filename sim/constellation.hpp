@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The simulator's own nominal GPS constellation: Keplerian broadcast ephemerides, nothing downloaded
 // (docs/sim.md §5).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // GNSS observation simulation (docs/sim.md §6). For each epoch tag t (receiver time) and satellite s:
 //   t_rx = t - dt_r (GPST reception), antenna at t_rx, transmit time from the light time incl. the delays,
 //   P = rho + c dt_r - c (dt_s - TGD) + I + T + e_thermal + e_multipath (+ e_atm_sd + blunder at the rover)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Rover and base GNSS observations (GPS L1 C/A code, Doppler, C/N0) of the simulator (docs/sim.md §6).
 #pragma once
 

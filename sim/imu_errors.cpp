@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // IMU error model (docs/sim.md §4). Per axis and sample at rate f_s:
 //   x_meas = M (I + diag(s)) x_true + b0 + b_gm(t) + b_rw(t) + G f_true (gyro only) + n,  n ~ N(0, N_d^2 f_s)
 // with N_d the noise density (ARW/VRW in rad/sqrt(s), m/s/sqrt(s)), b_gm a first-order Gauss-Markov process

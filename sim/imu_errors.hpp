@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // IMU error model of the simulator (docs/sim.md §4): measured = saturate(quantize(M (I + S) x + b(t) + G f + n)).
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Deterministic random numbers for the simulator: xoshiro256** (Blackman & Vigna 2018) seeded through
 // splitmix64, normal deviates by the Marsaglia polar method. Self-contained so that the same seed gives the
 // same numbers on every platform and standard library (std::normal_distribution is implementation-defined).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Scenario validation: every problem at once, named by the YAML key it comes from (README "Scenario files").
 #include "sim/scenario.hpp"
 

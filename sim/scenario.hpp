@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // A simulator scenario (SI inside; io/scenario_config.* reads it from YAML with unit-suffixed keys).
 // The models and their sources are described in docs/sim.md.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Simulator driver (docs/sim.md): plan -> walk truth + exact IMU -> IMU errors -> antenna -> GNSS.
 #include "sim/simulator.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The simulator: scenario -> foot truth, IMU samples, antenna truth, rover/base GNSS observations and the
 // nominal constellation. Pure: returns data, writes nothing (pipeline/simulate_command.* writes the files).
 #pragma once

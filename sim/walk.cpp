@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Walker motion (docs/sim.md §1-3): stride planning, swing design, exact IMU synthesis, body track.
 #include "sim/walk.hpp"
 

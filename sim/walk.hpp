@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Walker motion: a stride plan from a route (waypoints) or a given track, the foot (IMU) truth and its exact
 // IMU samples, and the walker's body/antenna track. Models: docs/sim.md §1-3.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The three callbacks librtklib expects its executable to define. pednav reports through return values
 // instead, so they do nothing. Forced into every binary through -Wl,-u (gnss/CMakeLists.txt).
 #include "gnss/rtklib/rtklib_c.hpp"

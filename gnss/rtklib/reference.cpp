@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Test oracle: pednav ephemeris types converted back to RTKLIB's eph_t/geph_t and evaluated by RTKLIB.
 #include "gnss/rtklib/reference.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // RTKLIB's own broadcast-orbit functions (eph2pos/geph2pos/eph2clk) and its Klobuchar model (ionmodel), exposed
 // ONLY as test oracles for gnss/ephemeris.* and gnss/measurement.* (pednav itself computes satellite states and
 // broadcast corrections without RTKLIB).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // RTKLIB adapter: RINEX observation and navigation reading, converted to pednav types at this boundary.
 #include "gnss/rtklib/rinex.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // RINEX reading through RTKLIB 2.4.3 b34 (Debian). The only door to RTKLIB: call from ONE thread
 // (RTKLIB keeps static buffers and globals).
 #pragma once

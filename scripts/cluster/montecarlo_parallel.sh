@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # A pednav Monte Carlo study sharded over GNU parallel (local cores, or other machines with --sshloginfile), then
 # merged: the result is what one `pednav montecarlo` process writes (docs/scale.md).
 # Usage: scripts/cluster/montecarlo_parallel.sh SCENARIO.yaml RUNS SHARDS OUT [extra pednav montecarlo flags...]

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav montecarlo` flags that change the filter reach it (docs/consistency.md §1, §3.12): the same seeds with
 // and without `--no-doppler` give different per-run errors, and the same flags twice give identical ones; the
 // figures are written unless `--no-plots`.

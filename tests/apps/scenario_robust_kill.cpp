@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Atomic outputs (issue 11, docs/robustness.md): `pednav run` killed by a signal at random moments (fixed seed) leaves
 // no partial file under a final name: every output present is identical to the one of an undisturbed run
 // (summary.json: apart from its wall-clock time). Temporary "<name>.tmp.<pid>" files may remain after SIGKILL.

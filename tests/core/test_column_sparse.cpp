@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // ColumnSparse (core/column_sparse.hpp): the products that skip zeros equal the dense products, for the engine's
 // sizes and the edges, on matrices shaped like Φ of the INS error model (dense 3×3 blocks and scattered entries).
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Monte Carlo aggregation (eval/montecarlo.*, issue 9): χ² band quantiles against table values, NEES and σ ratio
 // on synthetic runs with a known covariance (consistent → inside the band; errors 1.5× too large → above it), and
 // seed 000's reduced per-channel Kalman filter (δV, β, ε with the Schuler term): with M runs the sample σ of the

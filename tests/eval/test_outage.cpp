@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // eval/outage.* and eval/statistics.*: window placement, which satellites a partial outage keeps (seed 004:
 // drop the lowest elevation while more than N remain), per-window figures, RMS across windows vs time since the
 // outage started (seed 004 Figure 17), CDF, per-segment and vertical statistics.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // A level IMU (FRD body = NED, yaw 0) at 200 Hz near Toronto, noise-free, whose stance is given as labels
 // (zupt.detector labels), run in ins mode with the GX5-25 spec: the scenario tests of what the engine makes of a
 // stance that is not static (ZARU gate, initial gyro bias from the first still period).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The gyro's g-sensitivity as 9 random-constant filter states (ImuSpec::gyro_g_sensitivity, docs/error_state.md §5).
 // The simulator adds G f to the measured rate (sim/imu_errors.cpp); during a stride the foot's specific force swings
 // through several g, so G f is not a constant bias the bias states could take. A walk with an exaggerated

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Mode ins on an uncalibrated gyro (docs/consistency.md §3.16): the Crista's data-sheet gyro scale-factor σ is 1 %,
 // so on datasets/indoor_loops (three corridor loops, 1080° of net turning) the unmodelled scale factors alone make
 // ~10° of heading error by the end. `scale_factors.states: auto` gives mode ins the scale-factor states for such a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The part of the foot-to-antenna lever arm fixed in the foot's heading frame (EngineOptions::lever_arm_heading_m,
 // docs/fusion.md §14). The simulated walker carries the antenna over the walking line while the IMU foot is
 // gait.foot_offset_m to its right (exaggerated here to 0.5 m so one seed shows it above the code noise). Without the

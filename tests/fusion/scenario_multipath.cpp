@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Code-multipath Gauss-Markov states of the forward filter (docs/consistency.md §3, EngineOptions::multipath_*):
 // on a simulated static open-sky start (the simulator's multipath: per satellite and receiver, σ 0.28 m at
 // C/N0 ≥ 45 dB-Hz, τ = 20 s) a filter that takes the code errors as white averages ~20 epochs that carry one

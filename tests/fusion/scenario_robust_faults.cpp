@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Fault injection into the tightly coupled engine (issue 11, docs/robustness.md): a simulated open-sky walk with a
 // base, one fault per test (receiver clock jump, pseudorange blunder, missing ephemeris, base that stops, IMU garbage
 // that makes the filter diverge, non-finite samples, 10 minutes without satellites). Each run must complete without

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Errors-in-variables compensation of the scale-factor updates (EngineOptions::scale_bias_compensation,
 // docs/consistency.md §3.6). The simulated IMU has white noise, quantization and biases but no scale-factor,
 // misalignment or g-sensitivity errors, so the true scale factors are 0 while the filter estimates them with the

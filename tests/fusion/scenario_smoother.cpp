@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // RTS smoother of the closed-loop filter (issue 6) on the simulated forest walk (datasets/forest_walk.yaml, seed
 // 004's outdoor test, simulated in memory as in scenario_tc.cpp): smoothed vs forward accuracy against the foot
 // truth, smoothed sigma <= forward sigma at every output epoch, smoothed errors inside 3 sigma, and a 60 s full

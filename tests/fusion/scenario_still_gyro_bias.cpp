@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The initial gyro bias from the first still period (docs/ins.md §6, eq. 6.1). A level IMU with a true z-gyro bias
 // rests 3 s, every sample labelled stance, then a 0.1-s swing gap and 3 s more of stance:
 // - static: the still period's mean rate is the bias; it is within the turn-on prior and the filter starts from it;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Tightly coupled filter on the simulated forest walk (datasets/forest_walk.yaml, seed 004's outdoor test): forward
 // TC with SD code + Doppler, accuracy against the simulator's truth, fault rejection of the simulated blunders,
 // automatic heading initialization. Bounds: the figures measured on 2026-12-05 (Release build) plus a stated margin

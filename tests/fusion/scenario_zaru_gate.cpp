@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // ZARU innovation gate (EngineOptions::zaru_gate_probability, docs/fusion.md §5.3). A foot that turns on the spot
 // during a detected stance is at zero velocity but not at zero rate: a ZARU there tells the filter that the rotation
 // is gyro bias. Here a level IMU rests 3 s (levelling window 0-2.5 s), then turns about its vertical at 0.3 rad/s for 3 s while every sample is

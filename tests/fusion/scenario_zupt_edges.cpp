@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // ZUPT stance edges (docs/zupt.md §5, EngineOptions::zupt_edge_s). On a noise-free simulated walk the SHOE detector
 // flags the first and last 10-40 ms of each stance while the simulated foot still moves by a few mm/s (1.2 cm/s at
 // the first flagged sample of a landing). Those ZUPTs are one-sided — always along the walk — so each stride is cut

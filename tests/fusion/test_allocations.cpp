@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Issue 10: nothing in the per-epoch path of the forward filter + smoother allocates on the heap. This executable
 // replaces the global operator new with a counting one; the engine's test hook EngineInputs::on_step is called at
 // the end of every mechanization step, so the allocations made by each step (prediction, ZUPT/ZARU, GNSS update,

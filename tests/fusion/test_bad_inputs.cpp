@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Bad input to the forward engine and to `pednav run` (issue 5 "Bad input"): clear errors, messages asserted.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

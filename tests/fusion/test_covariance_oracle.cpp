@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Closed-form covariance oracles of seed 001 (issue 9) for the filter's own covariance recursion: the engine's
 // discrete error model (ins::interval_error_model at the 20 Hz mechanization rate) and its ZUPT Jacobian
 // (fusion::zupt_jacobian, Joseph update) in the seed 001 setting — constant step period T, one instantaneous ZUPT

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Filter health: a diverging run is a reported failure, never a confident absurd trajectory (issue 5/11).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

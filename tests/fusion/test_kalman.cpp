@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The engine's covariance prediction and Joseph update (fusion/kalman.hpp) against their textbook dense forms:
 // P ← Φ P Φᵀ + Q_d and P ← (I − K H) P (I − K H)ᵀ + K R Kᵀ (Groves 2013 eqs. 3.15, 3.22). The fast paths work on
 // the non-zeros of Φ and H and on the upper triangle only (docs/performance.md §1, docs/fusion.md eq. 6.4), so the

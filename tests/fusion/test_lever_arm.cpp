@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The foot-IMU -> antenna lever arm with a part fixed in the foot's heading frame (fusion/lever_arm.hpp,
 // docs/fusion.md §14): its value at known headings, and its attitude Jacobian (eq. 14.2) against numerical
 // differentiation through the error-state attitude perturbation, for level and strongly pitched feet.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // RTS core (fusion/rts.*) on a linear-Gaussian problem: a closed-loop Kalman filter (nominal corrected after each
 // update, error estimate reset to zero) feeding the interval bookkeeping of the engine (RtsInterval, docs/fusion.md
 // eqs. 12.14-12.20) and, as the reference, the per-step backward maps (rts_step + RtsAccumulator, eqs. 12.1-12.11),

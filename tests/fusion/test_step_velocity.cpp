@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Step-velocity aiding (fusion/step_velocity.*, seed 000): the inverted-pendulum step length, the analytic Jacobian
 // of the along/cross-track/vertical average-velocity measurement against central differences through the error-state
 // boxplus (v + δv, exp([φ×]) R) at several attitudes, and the step segmentation of StepTracker.

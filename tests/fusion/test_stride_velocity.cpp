@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The stride-average foot velocity that the Doppler rows predict for a body-worn antenna (fusion/stride_velocity.hpp,
 // docs/fusion.md §13): the window, the cycle from the stance onsets, and the attitude Jacobian (eq. 13.2) against
 // numerical differentiation.

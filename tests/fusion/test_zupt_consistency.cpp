@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Seed 001 consistency test (issue 5, ../shared/DESIGN.md "Measurement models"): ZUPT-only on a simulated walk.
 // With form D (seed 001 eq. 8) heading is unobservable and its variance grows as a random walk,
 // P_yaw(k+1) = P_yaw(k) + σ_ω² T per step (seed 001 eq. 19), i.e. at σ_ω² [rad²/s]; with form F (eq. 9) the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // ZUPT measurement Jacobians (docs/fusion.md §5) against numerical differentiation through the error state's
 // boxplus (docs/error_state.md §1: x_true = x_est ⊞ δx, R_true = exp([φ×]) R_est, δx = true − est).
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // pednav broadcast satellite positions and clocks against RTKLIB's eph2pos/geph2pos on real nav files
 // (GPS, GLONASS, Galileo, BeiDou incl. GEO, QZSS), every ephemeris at several times within its validity.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The RTKLIB adapter on real RINEX 2.10 and 3.04 files from ../shared/datasets.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Doppler smoothing of the code (gnss/code_smoothing.hpp, docs/gnss.md "Doppler smoothing of the code"): noise reduction against the recursive
 // filter's steady state, receiver clock jumps carried through, restarts on gaps and code jumps, off when window 0.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Broadcast satellite states on synthetic ephemerides: orbit radius, velocity and clock drift against
 // central differences of the position/clock functions, ephemeris selection messages.
 #include <gmock/gmock.h>

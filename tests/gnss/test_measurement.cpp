@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // SD/UD pseudorange and range-rate Jacobians against central differences; weighting; chi-square quantiles.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // RINEX reading through the RTKLIB adapter (gnss/rtklib/rinex): inputs found by fuzz/fuzz_rinex (issue 11,
 // docs/robustness.md). A date far outside the GPS time range in a navigation or observation record overflowed the
 // nanosecond count (UBSan); records dated before the GPS epoch or after 2106 are now dropped (and counted). Meaningful under the ASan + UBSan build.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // HMM zero-velocity detector (seed 002; docs/zupt.md §3) on real logs with the committed configurations, detector
 // switched to hmm: the mapping rules measured on the x-io long loop, and the push-off rule on LORD hallway #34.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Analytic test motions with exact IMU synthesis (ECEF mechanization equations run backwards):
 //   omega_ib_b = omega_eb_b + R_b_e omega_ie_e,   f_ib_b = R_b_e (a_e - g(p_e) + 2 omega_ie x v_e).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Coarse levelling, stillness detection, heading.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // ins::calibrate_imu on synthetic logs whose truth is known: still periods, bias, noise density, gravity axis, rate,
 // gait, and the warnings of logs that cannot tell everything (docs/ins.md §10).
 #include "ins/calibration.hpp"

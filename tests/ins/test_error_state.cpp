@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Error-state model: layout, boxplus/boxminus, F against numerical differentiation through boxplus,
 // discrete Φ against the nonlinear mechanization over 1 s of foot motion, Qd discretizations.
 #include <gmock/gmock.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Tests of ins/hmm.*: forward-backward and Viterbi against brute-force enumeration, Baum-Welch monotonicity and
 // recovery of a known generator, observation extraction and the mapping of decoded states to samples.
 #include "ins/hmm.hpp"

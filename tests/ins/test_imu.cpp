@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Increment integration: grid alignment, interpolation, coning and sculling against analytic motions.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // ECEF mechanization: gravity model, stationary drift (1 h), Schuler period, foot-like motion per rate.
 #include <gtest/gtest.h>
 

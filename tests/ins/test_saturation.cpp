@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Saturated IMU samples (ins/saturation.hpp, docs/ins.md §9): runs found per axis and sensor, reconstruction from
 // the neighbours (exact for a quartic, close for swing-like peaks), its σ, and the cases that must not be repaired.
 #include <gmock/gmock.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Tests of ins/zupt_detector.*: every detector on a synthetic still / moving log, option problems, and the HMM
 // detector end to end (seed 002 initial model trained on the log itself) on a synthetic gait.
 #include "ins/zupt_detector.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // report.html rendered by a real browser (Debian chromium, headless, no network): after loading, the page's own
 // script counts the embedded plots the browser decoded (complete, naturalWidth > 0) into #plot-status; the dumped
 // DOM must say all of them. Label `browser` (docs/outage.md: chromium's install time and the CI choice).

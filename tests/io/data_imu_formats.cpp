@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Every shared foot IMU data set loads with its format preset; rate, duration, rest |f| and dropped duplicates
 // are checked against the data sets' SOURCE.md.
 #include <gtest/gtest.h>

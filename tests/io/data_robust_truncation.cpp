@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Truncation of real files (issue 11, docs/robustness.md): RINEX 3.04 (Septentrio rover), RINEX 2.11 (GLW1 CORS) and
 // an x-io NGIMU log cut at many offsets within their first few hundred kB (mid-line included). Reading gives exactly
 // a prefix of the uncut data (no cut number kept) with the truncation reported, or an error naming the file.

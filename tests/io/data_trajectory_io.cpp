@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Trajectory readers on the real reference files of ../shared/datasets.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # ctest io.map_formats (label scenario): output.formats geojson and kml of `pednav run` read back with real parsers —
 # Python's json (RFC 7946: a FeatureCollection, [lon, lat, h] positions, no crs member, one Point per solution.csv
 # row plus the LineString) and xmllint + Python's xml.etree (well-formed KML 2.2, one Placemark per row plus the track,

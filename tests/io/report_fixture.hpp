@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // A small synthetic run folder for the report tests: a 1 Hz walk east at 1 m/s with a known error, forward and
 // smoothed solutions (pednav CSV), a reference, evaluation files and one outage study subfolder.
 #pragma once

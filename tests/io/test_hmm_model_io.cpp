@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Tests of io/hmm_model_io.*: hmm.yaml round trip, bad model files, zupt.hmm_* config keys.
 #include "io/hmm_model_io.hpp"
 

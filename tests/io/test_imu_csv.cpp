@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // IMU CSV reader: time bases, units, axes/mounting, messy-log handling and the messages of bad input.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

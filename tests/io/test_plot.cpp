@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // io/plot.* (gnuplot as SVG renderer) and io/plot_figures.*: the script carries the data and styles, gnuplot
 // renders it, a missing gnuplot is a clear message.
 #include <gmock/gmock.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // io/report.*: numeric CSV tables, base64, and report.html of a small synthetic run folder (self-contained:
 // every plot an SVG data URI; sections for the evaluation, trajectory, errors, satellites, ZUPTs, outages).
 #include <gmock/gmock.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // RINEX 3.04 writers (io/rinex_writer.*): RTKLIB reads the simulator's obs and nav files back
 // (gnss/rtklib/rinex.hpp) with the same values and the same satellite geometry.
 #include <gtest/gtest.h>

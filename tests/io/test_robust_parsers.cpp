@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Robustness of the readers (issue 11, docs/robustness.md): fault injection into IMU logs (truncation at every
 // offset, NaN/inf fields, saturation, gaps, backwards time, duplicate bursts, unit mistakes) and the inputs the
 // fuzz targets of fuzz/ found. Every input gives data or an error naming the file and line, never a crash or NaN.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Scenario imu.spec: a preset name, or a map overriding the preset's values (simulation only: the written run
 // configuration names the preset, so a map makes a filter/simulator model-mismatch study).
 #include <gmock/gmock.h>

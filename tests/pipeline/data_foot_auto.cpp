@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The out-of-the-box configuration (datasets/foot/pyshoe_auto.yaml: `imu.spec: auto`, `zupt.shoe_threshold: auto`,
 // every other key default) on all 24 PyShoe Vicon trials, scored as scripts/pyshoe_cv does, and on the x-io loops.
 // The auto knobs (motion allowance 1.5, the ZARU gate and stance edges of `auto`) were chosen on the 4 `original`

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // INS/ZUPT (`mode: ins`) on real foot data with the committed configurations of datasets/foot/ (issue 5):
 // x-io short loop closure, the mean start-aligned horizontal error of the four PyShoe Vicon trials, and the error of
 // LORD #35 at its footprints. Each bound is the figure measured on 2026-12-05 (Release build) plus a stated margin

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav gnss` on the real data sets: the "Done when" figures of issue 3 (docs/results.md), and bad inputs.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav montecarlo --shard K/N` + `pednav montecarlo-merge` (docs/scale.md): 40 runs as one process and as 4 shards
 // merged give byte-identical runs.csv (without its wall_s column), nees.csv and summary.json (without its wall-clock
 // and thread-count keys); a missing, duplicated or foreign shard is a clear error naming it.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav outage` on a short simulated open-sky walk (datasets/circle_304m.yaml): outputs and their columns (DESIGN.md), the partial mask
 // leaves at most N satellites, a full outage empties the epochs and moves the solution away from the run without
 // outage, and bad options name what is wrong.

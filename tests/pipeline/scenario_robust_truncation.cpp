@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Truncated input files (issue 11, docs/robustness.md): a simulated rover RINEX 3 file and IMU log cut at many
 // offsets, mid-line included. Reading gives a prefix of the full data with the truncation reported (never a cut
 // number), or an error naming the file; `pednav run` on cut files completes with the truncation in summary.json or

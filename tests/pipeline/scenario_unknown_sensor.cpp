@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // A foot IMU nobody tuned pednav to (issue 37; datasets/unknown_sensor.yaml): seed 004's indoor loops with the sensor
 // mounted z axis up and rolled 30° about the foot's long axis, a 0.5 °/s turn-on gyro bias σ, 3× the Crista's white
 // noise, 500 Hz. `pednav calibrate` must recover what it can see, and `imu.spec: auto` + `zupt.shoe_threshold: auto`

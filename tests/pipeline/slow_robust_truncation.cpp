@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Truncation sweep (issue 11, docs/robustness.md; label slow): a simulated rover RINEX 3 file cut at EVERY line end
 // and in the middle of every line of its body, and the IMU log at every 20th line (both ways). Every read gives
 // exactly a prefix of the full data with a mid-line cut reported, or an error naming the file.

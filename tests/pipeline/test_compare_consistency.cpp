@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav compare` with a pednav solution CSV that carries its own σ: evaluation.json "consistency" (share of epochs
 // inside 3σ, normalized squared error), and no such block after an alignment that rotates the axes.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Every input path is checked before any processing (issue 36): a run whose reference file does not exist fails at
 // once naming the key and the path, and writes no output folder.
 #include <gmock/gmock.h>

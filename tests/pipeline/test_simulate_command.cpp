@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav simulate` outputs (pipeline/simulate_command.*): same seed -> byte-identical files; a different seed
 // changes them; config.yaml loads as a run configuration pointing at the written files; config_datasheet.yaml
 // loads to the scenario's own sensor models.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // `pednav zupt` (pipeline::run_zupt_command): zupt.csv / summary.json, and the agreement of a detector with the stance
 // labels of the log (imu.format stance.column) — PyShoe's stored labels, or any reference the user has.
 #include <gmock/gmock.h>

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # ctest scale.batch_resume (label scale): `pednav batch` over the shared foot logs and a simulated scenario (run and
 # gnss), once uninterrupted and once killed (SIGKILL) halfway and restarted: the restart finishes only what was left
 # and index.csv / summary.csv are the same as the uninterrupted run's (docs/scale.md).

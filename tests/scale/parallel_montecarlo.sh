@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # ctest scale.parallel_montecarlo (label scale): scripts/cluster/montecarlo_parallel.sh runs 4 shards of 12 runs under
 # GNU parallel and merges them; the result must equal one `pednav montecarlo` process (wall-clock fields excluded).
 set -euo pipefail

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # ctest scale.slurm_montecarlo (label slow): a single-node Slurm on localhost (Debian slurm-wlm + munge, installed by
 # this script when missing; ../shared/notes/slurm_single_node.md) runs scripts/cluster/montecarlo_slurm.sbatch as an
 # array of 4 shards, then the merge as a dependent job; the result must equal one `pednav montecarlo` process

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Along-a-track mode on the real Galway walk (datasets/galway_track.yaml): the synthesized foot IMU is aligned in
 // GPST with the real GNSS, the foot truth follows the RTK track, and the written config.yaml runs `pednav gnss`
 // on the REAL rover/base/nav files with the GGA track as reference.

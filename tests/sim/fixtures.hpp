@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Shared scenario texts and helpers of the simulator tests.
 #pragma once
 

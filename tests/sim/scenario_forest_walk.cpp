@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Calibration of datasets/forest_walk.yaml against seed 004 Table 1 (GPS-only LSQ, SiRF under canopy):
 // `pednav gnss` on the simulated data, compared with truth.csv, gives a horizontal RMS of 5.3 m +- 25 % and
 // 74.1 % +- 10 points of epochs under 5 m. Also checks the scenario's headline figures (18 min, ~900 m,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // GNSS observation simulation (sim/gnss_sim.*, sim/constellation.*): with the true positions and clocks the
 // single-difference residuals have the configured standard deviations; blunders appear at the configured
 // rate and are recorded; the nominal constellation is a proper 24+ satellite GPS constellation.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Foot truth and IMU synthesis (sim/walk.*): the noise-free IMU written to imu.csv mechanizes back onto
 // truth.csv; gait statistics match seed 004 (cycle, stance share) and the pitch rates.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // A counting replacement of the global operator new/delete (malloc-backed) for the allocation checks of issue 10:
 // include it in exactly ONE translation unit of an executable (a replacement must be defined once); read
 // g_allocs before and after the code under test.

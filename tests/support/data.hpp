@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Access to the real data sets in ../shared/datasets: skip when absent, FAIL under CI=true.
 #pragma once
 

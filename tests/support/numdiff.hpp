@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Central-difference Jacobians for checking analytic ones.
 #pragma once
 
