@@ -148,7 +148,7 @@ std::string to_yaml(const RunConfig& c) {
   e << YAML::Key << "mechanization_rate_hz" << YAML::Value << c.mechanization_rate_hz;
   e << YAML::Key << "zupt" << YAML::Value << YAML::BeginMap << YAML::Key << "detector" << YAML::Value
     << c.zupt.detector << YAML::Key << "form" << YAML::Value << c.zupt.form << YAML::Key << "edge_s" << YAML::Value
-    << c.zupt.edge_s << YAML::EndMap;
+    << c.zupt.edge_s << YAML::Key << "updates" << YAML::Value << c.zupt.updates << YAML::EndMap;
   e << YAML::Key << "fault_rejection" << YAML::Value << YAML::BeginMap << YAML::Key << "probability"
     << YAML::Value << c.fault_rejection_probability << YAML::Key << "window_epochs" << YAML::Value
     << c.fault_rejection_window_epochs << YAML::EndMap;
@@ -168,6 +168,15 @@ std::string to_yaml(const RunConfig& c) {
     << (m.bias_random_walk ? "random_walk" : "gauss_markov") << YAML::EndMap;
   e << YAML::Key << "saturation" << YAML::Value << YAML::BeginMap << YAML::Key << "repair" << YAML::Value
     << c.saturation.repair << YAML::EndMap;
+  {
+    const fusion::StepVelocityOptions& sv = c.step_velocity;
+    e << YAML::Key << "step_velocity" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled" << YAML::Value
+      << sv.enabled << YAML::Key << "leg_length_m" << YAML::Value << sv.leg_length_m << YAML::Key << "sigma_along_mps"
+      << YAML::Value << sv.sigma_along_mps << YAML::Key << "sigma_cross_mps" << YAML::Value << sv.sigma_cross_mps
+      << YAML::Key << "sigma_vertical_mps" << YAML::Value << sv.sigma_vertical_mps << YAML::Key << "min_step_s"
+      << YAML::Value << sv.min_step_s << YAML::Key << "max_step_s" << YAML::Value << sv.max_step_s << YAML::Key
+      << "min_rise_m" << YAML::Value << sv.min_rise_m << YAML::EndMap;
+  }
   e << YAML::Key << "output" << YAML::Value << YAML::BeginMap << YAML::Key << "rate_hz" << YAML::Value
     << c.output.rate_hz << YAML::Key << "formats" << YAML::Value << YAML::Flow << c.output.formats << YAML::EndMap;
   e << YAML::EndMap;

@@ -11,6 +11,7 @@
 #include "core/expected.hpp"
 #include "ins/hmm.hpp"
 #include "ins/imu_spec.hpp"
+#include "fusion/step_velocity.hpp"
 #include "io/imu_csv.hpp"
 
 namespace YAML {
@@ -86,6 +87,7 @@ struct ZuptConfig {
   bool edge_s_given = false;               ///< zupt.edge_s was in the file (else `auto` may choose it)
   bool zaru_gate_given = false;            ///< zupt.zaru_gate_probability was in the file
   bool zaru_sigma_given = false;           ///< zupt.zaru_sigma_deg_per_s was in the file
+  bool updates = true;                     ///< key updates: false = the detector only segments steps (step velocity)
   double min_stance_s = 0.04;
   double are_threshold = 10.0;            ///< ARE γ (Skog et al. 2010 eq. 8)
   double mag_threshold = 2.0;             ///< MAG γ (Skog et al. 2010 eq. 9)
@@ -201,6 +203,9 @@ struct RunConfig {
   MultipathConfig multipath;
   ScaleFactorConfig scale_factors;
   BiasConfig bias;
+  /// `step_velocity:` seed 000 step-averaged velocity aiding (fusion/step_velocity.hpp; docs/consistency.md §5): the
+  /// inverted-pendulum step length over each step's duration against the INS average velocity. Off by default.
+  fusion::StepVelocityOptions step_velocity;
   SaturationConfig saturation;
 };
 

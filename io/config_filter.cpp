@@ -36,6 +36,7 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
     c.edge_s_given = z.has("edge_s");
     z.number("edge_s", c.edge_s, false, 0.0, 1.0);
     z.boolean("zaru", c.zaru);
+    z.boolean("updates", c.updates);
     c.zaru_sigma_given = z.has("zaru_sigma_deg_per_s");
     double zs = c.zaru_sigma_radps * kRadToDeg;
     z.number("zaru_sigma_deg_per_s", zs, false, 1e-9, 100.0);
@@ -44,6 +45,19 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
     z.number("zaru_gate_probability", c.zaru_gate_probability, false, 0.0, 0.999999);
     if (c.zaru_gate_probability > 0.0 && c.zaru_gate_probability <= 0.5)
       z.problem("zaru_gate_probability", "must be 0 (no gate) or in (0.5, 1)");
+  }
+  {
+    YamlMap v = top.map("step_velocity");
+    fusion::StepVelocityOptions& sv = out.step_velocity;
+    v.boolean("enabled", sv.enabled);
+    v.number("leg_length_m", sv.leg_length_m, false, 0.05, 3.0);
+    v.number("sigma_along_mps", sv.sigma_along_mps, false, 1e-4, 10.0);
+    v.number("sigma_cross_mps", sv.sigma_cross_mps, false, 1e-4, 10.0);
+    v.number("sigma_vertical_mps", sv.sigma_vertical_mps, false, 1e-4, 10.0);
+    v.number("min_step_s", sv.min_step_s, false, 0.05, 10.0);
+    v.number("max_step_s", sv.max_step_s, false, 0.1, 60.0);
+    v.number("min_rise_m", sv.min_rise_m, false, 0.0, 1.0);
+    if (sv.max_step_s <= sv.min_step_s) v.problem("max_step_s", "must be > min_step_s");
   }
   {
     YamlMap i = top.map("initial");

@@ -102,6 +102,8 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.zupt.min_stance_s = c.zupt.min_stance_s;
   o.zupt = zupt_detector_options(c.zupt);  // all detector keys incl. ARE/MAG/HMM (io/hmm_model_io.cpp)
   o.zupt_form = c.zupt.form == "F" ? fusion::ZuptForm::kFull : fusion::ZuptForm::kDynamic;
+  o.step_velocity = c.step_velocity;
+  o.zupt_updates = c.zupt.updates;
   o.zupt_sigma_mps = c.zupt.sigma_mps;
   o.zupt_edge_s = c.zupt.edge_s;
   o.zaru = c.zupt.zaru;
@@ -350,6 +352,7 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
     }
     j["imu_estimate"] = e;
   }
+  if (c.step_velocity.enabled) j["step_velocity"] = {{"updates", sum.step_velocity_updates}};
   j["zupt"] = {{"detector", c.zupt.detector}, {"form", c.zupt.form}, {"updates", sum.zupt_updates},
                {"stance_samples", sum.zupt_samples}, {"zaru_updates", sum.zaru_updates},
                {"zaru_rejected_by_gate", sum.zaru_rejected}};

@@ -388,3 +388,29 @@ TEST(Config, AutoSpecAndAutoThresholdAreFlagsAndMisspellingsAreNamed) {
 
 }  // namespace
 }  // namespace pednav::io
+
+namespace pednav::io {
+namespace {
+
+// `step_velocity:` and `zupt.updates` (seed 000 aiding): parsed, written to config.resolved.yaml, bad values named.
+TEST(Config, StepVelocityKeysRoundTripAndBadValuesAreNamed) {
+  const std::string base = "mode: ins\nimu:\n  file: imu.csv\n  format: pyshoe\n  spec: gx5_25\n"
+                           "initial: {lat_deg: 45, lon_deg: 0, h_m: 0, yaw_deg: 0}\n";
+  auto cfg = parse(base + "zupt:\n  updates: false\nstep_velocity:\n  enabled: true\n  leg_length_m: 2.96\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_TRUE(cfg->step_velocity.enabled);
+  EXPECT_DOUBLE_EQ(cfg->step_velocity.leg_length_m, 2.96);
+  EXPECT_FALSE(cfg->zupt.updates);
+  auto again = parse(to_yaml(*cfg));
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_TRUE(again->step_velocity.enabled);
+  EXPECT_DOUBLE_EQ(again->step_velocity.leg_length_m, 2.96);
+  EXPECT_FALSE(again->zupt.updates);
+  auto bad = parse(base + "step_velocity:\n  min_step_s: 2\n  max_step_s: 1\n  leg: 1\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("step_velocity.max_step_s: must be > min_step_s"));
+  EXPECT_THAT(bad.error().message, HasSubstr("step_velocity.leg"));
+}
+
+}  // namespace
+}  // namespace pednav::io
