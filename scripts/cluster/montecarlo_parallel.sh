@@ -14,7 +14,7 @@ shift 4
 mkdir -p "$out"
 # One shard per job; a failed shard fails the study (--halt now,fail=1). Re-running resumes: done runs are kept.
 # shellcheck disable=SC2086
-parallel --halt now,fail=1 ${PARALLEL_OPTS:-} \
+parallel --will-cite --halt now,fail=1 ${PARALLEL_OPTS:-} \
   "$pednav" -q montecarlo "$scenario" --runs "$runs" --jobs "${JOBS_PER_SHARD:-1}" --no-plots --shard {}/"$shards" \
   -o "$out/shard_{}" "$@" ::: $(seq 1 "$shards")
 dirs=()
