@@ -64,9 +64,5 @@ for _ in $(seq 1 300); do
   sleep 1
 done
 [ -s "$out/merged/summary.json" ] || { echo "slurm: no merged summary"; cat "$work/log/"*.log; exit 1; }
-"$pednav" -q montecarlo "$root/datasets/indoor_loops.yaml" --runs 12 --jobs 2 --no-plots -o "$work/one"
-cmp "$work/one/nees.csv" "$out/merged/nees.csv"
-diff <(cut -d, -f1-3,5- "$work/one/runs.csv") <(cut -d, -f1-3,5- "$out/merged/runs.csv")
-strip='import json,sys; d=json.load(open(sys.argv[1])); [d.pop(k) for k in ("wall_s","run_wall_s_sum","jobs","runs_done_now")]; print(json.dumps(d, sort_keys=True))'
-diff <(python3 -c "$strip" "$work/one/summary.json") <(python3 -c "$strip" "$out/merged/summary.json")
+"$root/tests/scale/same_as_one_process.sh" "$pednav" "$root" "$work" "$out/merged"
 echo "slurm_montecarlo: 4 array tasks + dependent merge = one process ($(( $(date +%s) - t0 )) s including set-up)"
