@@ -89,17 +89,20 @@ InsState euler_step(const InsState& x, const Eigen::Vector3d& omega_m, const Eig
   return y;
 }
 
-// F_num = (∂/∂δx [step(x ⊞ δx) ⊟ step(x)] - I) / h at δx = 0 (central differences, per-block steps), compared block
-// by block with continuous_error_model; the last 2 states are a clock block the INS model does not own.
-void expect_continuous_f_matches_numerical(const ErrorStateLayout& l, const InsState& x, const Eigen::VectorXd& steps) {
+// F_num = (∂/∂δx [step(x ⊞ δx) ⊟ step(x)] - I) / h at δx = 0 (central differences, per-block steps), and the analytic
+// F of continuous_error_model at the same corrected measurements; the last 2 states are a clock block the INS model
+// does not own (zeroed in F_num).
+struct FPair {
+  Eigen::MatrixXd analytic, numeric;
+  Eigen::Vector3d f_b;  // the corrected specific force the model was evaluated at
+};
+FPair continuous_f_pair(const ErrorStateLayout& l, const InsState& x, const Eigen::VectorXd& steps) {
   constexpr double kH_s = 1e-3;
-  constexpr double kTolRel = 5e-3;   // J2 part of the gravity gradient is omitted in F (< 0.3 %)
-  constexpr double kTolAbs = 1e-6;   // O(h) terms of the Euler step ([ω_ie×] products, ~1e-7)
   ImuSpec sp = *imu_spec_preset("crista");
   sp.scale_tau_s = 1000.0;
   const Eigen::Vector3d omega_m(2.0, -5.0, 1.0), f_m(8.0, -3.0, -12.0);
   const InsState x1 = euler_step(x, omega_m, f_m, sp, kH_s);
-  ASSERT_EQ(steps.size(), l.dim());
+  EXPECT_EQ(steps.size(), l.dim());
   Eigen::MatrixXd J(l.dim(), l.dim());
   for (int i = 0; i < l.dim(); ++i) {
     Eigen::VectorXd d = Eigen::VectorXd::Zero(l.dim());
@@ -108,17 +111,29 @@ void expect_continuous_f_matches_numerical(const ErrorStateLayout& l, const InsS
     const Eigen::VectorXd minus = boxminus(euler_step(boxplus(x, -d, l), omega_m, f_m, sp, kH_s), x1, l);
     J.col(i) = (plus - minus) / (2.0 * steps(i));
   }
-  Eigen::MatrixXd F_num = (J - Eigen::MatrixXd::Identity(l.dim(), l.dim())) / kH_s;
-  F_num.rightCols(2).setZero();  // clock block: not INS-owned
-  F_num.bottomRows(2).setZero();
+  FPair out;
+  out.numeric = (J - Eigen::MatrixXd::Identity(l.dim(), l.dim())) / kH_s;
+  out.numeric.rightCols(2).setZero();  // clock block: not INS-owned
+  out.numeric.bottomRows(2).setZero();
   // F at the corrected measurements (the model's ω_b, f_b are bias/scale/g-sensitivity-corrected).
-  const Eigen::Vector3d f = ((f_m - x.imu.b_a).array() / (1.0 + x.imu.s_a.array())).matrix();
-  const Eigen::Vector3d w = ((omega_m - x.imu.b_g - x.imu.G_g * f).array() / (1.0 + x.imu.s_g.array())).matrix();
-  const auto model = continuous_error_model(l, sp, x.nav.R_e_b(), x.nav.p_eb_e, f, w);
+  out.f_b = ((f_m - x.imu.b_a).array() / (1.0 + x.imu.s_a.array())).matrix();
+  const Eigen::Vector3d w = ((omega_m - x.imu.b_g - x.imu.G_g * out.f_b).array() / (1.0 + x.imu.s_g.array())).matrix();
+  out.analytic = continuous_error_model(l, sp, x.nav.R_e_b(), x.nav.p_eb_e, out.f_b, w).F;
+  return out;
+}
+
+// Block by block: |F − F_num| ≤ kTolAbs + kTolRel |F_num|; `left_out` (same size, may be empty) is what F leaves out on
+// purpose and is added to F before comparing.
+void expect_continuous_f_matches_numerical(const ErrorStateLayout& l, const InsState& x, const Eigen::VectorXd& steps,
+                                           const Eigen::MatrixXd& left_out = Eigen::MatrixXd()) {
+  constexpr double kTolRel = 5e-3;   // J2 part of the gravity gradient is omitted in F (< 0.3 %)
+  constexpr double kTolAbs = 1e-6;   // O(h) terms of the Euler step ([ω_ie×] products, ~1e-7)
+  const FPair F = continuous_f_pair(l, x, steps);
+  const Eigen::MatrixXd analytic = left_out.size() ? Eigen::MatrixXd(F.analytic + left_out) : F.analytic;
   for (const auto& [ri, rb] : l.blocks()) {
     for (const auto& [ci, cb] : l.blocks()) {
-      const Eigen::MatrixXd a = model.F.block(rb.offset, cb.offset, rb.dim, cb.dim);
-      const Eigen::MatrixXd n = F_num.block(rb.offset, cb.offset, rb.dim, cb.dim);
+      const Eigen::MatrixXd a = analytic.block(rb.offset, cb.offset, rb.dim, cb.dim);
+      const Eigen::MatrixXd n = F.numeric.block(rb.offset, cb.offset, rb.dim, cb.dim);
       EXPECT_LE((a - n).norm(), kTolAbs + kTolRel * n.norm()) << "F[" << ri << "," << ci << "]\nanalytic\n"
                                                                << a << "\nnumeric\n" << n;
     }
@@ -168,6 +183,32 @@ TEST(ErrorState, GSensitivityColumnsOfFMatchNumericalDifferentiation) {
   for (int j = 0; j < 3; ++j) {
     EXPECT_LT((model.F.block(kAtt.offset, g + 3 * j, 3, 3) + x.nav.R_e_b() * f(j)).norm(), 1e-12) << "column " << j;
   }
+}
+
+// At Ĝ_g ≠ 0 F leaves out exactly the attitude-row terms +R Ĝ_g δb_a + R Ĝ_g diag(f_b) δs_a (ω̂ is corrected by
+// Ĝ_g f̂, and f̂ carries the accelerometer errors; docs/error_state.md §5). The engine never has them: G_g is a consider
+// block whose gain rows are zeroed (fusion::ConsiderStates), so Ĝ_g ≡ 0 in every nominal state it propagates
+// (KalmanSizes.ConsiderStatesAreNotCorrectedAndPIsTheJosephFormOfTheirGain). This test pins that F is exact apart
+// from those two terms, and that they are what a nonzero Ĝ_g would need (the comparison fails without them).
+TEST(ErrorState, GSensitivityAtNonzeroEstimateLeavesOutOnlyTheAccelerometerCouplingTerms) {
+  Eigen::VectorXd steps(32);
+  steps << Eigen::Vector3d::Constant(1.0), Eigen::Vector3d::Constant(1e-4), Eigen::Vector3d::Constant(1e-5),
+      Eigen::Vector3d::Constant(1e-5), Eigen::Vector3d::Constant(1e-5), Eigen::VectorXd::Constant(6, 1e-5),
+      Eigen::VectorXd::Constant(9, 1e-6), Eigen::VectorXd::Constant(2, 1.0);
+  const ErrorStateLayout l = layout_with_g_sensitivity();
+  const InsState x = sample_state_with_g();
+  const FPair F = continuous_f_pair(l, x, steps);
+  const Eigen::Matrix3d RG = x.nav.R_e_b() * x.imu.G_g;
+  Eigen::MatrixXd left_out = Eigen::MatrixXd::Zero(l.dim(), l.dim());
+  left_out.block(kAtt.offset, kBiasAcc.offset, 3, 3) = RG;
+  left_out.block(kAtt.offset, l.find(kScaleAccBlock)->offset, 3, 3) = RG * F.f_b.asDiagonal();
+  expect_continuous_f_matches_numerical(l, x, steps, left_out);
+  // The left-out terms are far above the comparison's tolerance here (|R Ĝ_g| = |Ĝ_g| = 6.1e-4 against 1e-6 + 0.5 %), so
+  // the numerical Jacobian does see them: without them the b_a block misses by their full size.
+  const Eigen::Matrix3d miss = F.numeric.block(kAtt.offset, kBiasAcc.offset, 3, 3) -
+                               F.analytic.block(kAtt.offset, kBiasAcc.offset, 3, 3);
+  EXPECT_GT(RG.norm(), 100.0 * 1e-6);
+  EXPECT_LT((miss - RG).norm(), 0.01 * RG.norm());
 }
 
 TEST(ErrorState, GSensitivityBoxplusBoxminusRoundTrip) {

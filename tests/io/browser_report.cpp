@@ -60,9 +60,18 @@ TEST(BrowserReport, ChromiumShowsEveryPlot) {
   EXPECT_THAT(dom, HasSubstr("plots shown: " + std::to_string(test::kReportFixturePlots) + " of " +
                              std::to_string(test::kReportFixturePlots)))
       << "the page's load script did not see every plot decoded; DOM starts: " << dom.substr(0, 400);
+  // At 1280 px wide (a laptop screen) nothing runs past the right edge, with the appendix opened: the page's
+  // script measures every element's right edge after layout.
+  const std::string dom1280 = run_capture(chromium + flags + " --window-size=1280,900 --virtual-time-budget=10000 "
+                                          "--dump-dom file://" + r->path + " 2>/dev/null");
+  EXPECT_THAT(dom1280, ::testing::ContainsRegex("layout: fits 12[0-9][0-9] px"))
+      << "layout status: " << dom1280.substr(dom1280.find("layout-status"), 120);
+  // The first screen's text is what the browser shows first.
+  EXPECT_LT(dom1280.find("Smoothed horizontal RMS 0.14 m"), dom1280.find("<h2>Health</h2>"));
+  EXPECT_LT(dom1280.find("<h2>Health</h2>"), dom1280.find("Trajectory and errors against the reference"));
   // And a screenshot is a real, non-trivial PNG.
   const std::string png = d + "/report.png";
-  run_capture(chromium + flags + " --window-size=1100,3000 --screenshot=" + png + " file://" + r->path +
+  run_capture(chromium + flags + " --window-size=1280,3000 --screenshot=" + png + " file://" + r->path +
               " >/dev/null 2>&1");
   ASSERT_TRUE(std::filesystem::exists(png));
   EXPECT_GT(std::filesystem::file_size(png), 20000u) << "screenshot suspiciously small (blank page?)";

@@ -48,7 +48,19 @@ inline void write_report_fixture(const std::string& dir) {
   (void)io::write_solution_csv(dir + "/solution.csv", fwd);
   (void)io::write_solution_csv(dir + "/smoothed.csv", smo);
   std::ofstream(dir + "/config.resolved.yaml") << "mode: tc\nreference:\n  file: " << dir << "/reference.csv\n  format: csv\n";
-  std::ofstream(dir + "/summary.json") << "{\"mode\": \"tc\", \"output_epochs\": 300, \"zupt\": {\"updates\": 150}}\n";
+  // A run summary with the health keys pednav run writes and the long floats it holds (rounded by the report).
+  std::ofstream(dir + "/summary.json")
+      << "{\"mode\": \"tc\", \"output_epochs\": 300, \"initial_yaw_deg\": 92.86770608856047, "
+         "\"initial_gyro_bias_deg_per_h\": [2424.9135795483744, 271.8266973372757, -0.000012345678], "
+         "\"zupt\": {\"updates\": 150, \"zaru_updates\": 140, \"zaru_rejected_by_gate\": 0}, "
+         "\"gnss\": {\"epochs_read\": 300, \"epochs_skipped_no_base\": 2, \"epochs_outside_imu_span\": 0, "
+         "\"code\": {\"below_elevation_mask\": 30, \"innovation_fault\": 6, \"persistent_fault\": 1, \"used\": 1763}, "
+         "\"doppler\": {\"innovation_fault\": 0, \"used\": 1800}}, "
+         "\"health\": {\"healthy\": true, \"reinitializations\": 1, "
+         "\"events\": [\"re-initialized at 225120.0 s: speed 12.3 m/s\"]}, "
+         "\"accounting\": {\"imu_samples\": {\"read\": 30000, \"used\": 29990, \"rejected\": {\"nan\": 4}, "
+         "\"skipped\": {\"duplicate_time\": 6}}, \"gnss_measurements\": {\"read\": 1800}}, "
+         "\"wall_s\": 1.478328488}\n";
   std::ofstream(dir + "/evaluation.json")
       << "{\"horizontal_rms_m\": 0.35, \"horizontal_max_m\": 0.5, \"availability_pct\": 100, "
          "\"bins_pct\": {\"lt5\": 100, \"5to10\": 0, \"10to20\": 0, \"ge20\": 0}}\n";

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 
 #include "core/geodesy.hpp"
 #include "io/report.hpp"
@@ -77,6 +78,38 @@ TEST(Report, RunFolderGivesSelfContainedHtmlWithEveryPlot) {
   EXPECT_THAT(html, HasSubstr("<td>RTS smoothed</td>"));
   EXPECT_THAT(html, HasSubstr("Outage study: partial outages, 3 satellites kept"));
   EXPECT_THAT(html, HasSubstr("Per-segment statistics"));
+  // The first screen answers the question: headline, accuracy, health, then trajectory and errors; the summary is
+  // a collapsed appendix at the end.
+  ASSERT_GE(r->sections.size(), 4u);
+  EXPECT_EQ(r->sections[0], "Accuracy against the reference");
+  EXPECT_EQ(r->sections[1], "Health");
+  EXPECT_EQ(r->sections[2], "Trajectory and errors against the reference");
+  EXPECT_EQ(r->sections.back(), "Appendix: the full run summary");
+  EXPECT_THAT(html, HasSubstr("Smoothed horizontal RMS 0.14 m (max 0.20 m); forward horizontal RMS 0.35 m (max 0.50 m). "
+                              "Filter healthy, 1 re-initialization."));
+  EXPECT_LT(html.find("id=\"headline\""), html.find("<h2>Accuracy against the reference</h2>"));
+  EXPECT_LT(html.find("<h2>Health</h2>"), html.find("data:image/svg+xml"));
+  EXPECT_THAT(html, HasSubstr("<th>GNSS code rejected by fault detection</th><td>7 of 1800 (0.4 %), 1 of them as "
+                              "persistent faults</td>"));
+  EXPECT_THAT(html, HasSubstr("<th>GNSS epochs skipped</th><td>2 without base, 0 outside the IMU span of 300 read</td>"));
+  EXPECT_THAT(html, HasSubstr("<th>IMU samples rejected / skipped</th><td>4 / 6 of 30000</td>"));
+  EXPECT_THAT(html, HasSubstr("<th>stance updates</th><td>150 ZUPT updates, 140 ZARU</td>"));
+  EXPECT_THAT(html, HasSubstr("re-initialized at 225120.0 s: speed 12.3 m/s"));
+  EXPECT_THAT(html, HasSubstr("Report warnings: none."));
+  EXPECT_LT(html.find("<h2>Per-segment statistics"), html.find("<details id=\"appendix\">"));
+  // Rounded to meaningful digits, integers as integers (outside the base64 of the plots).
+  EXPECT_THAT(html, HasSubstr("<th>initial_yaw_deg</th><td>92.87</td>"));
+  EXPECT_THAT(html, HasSubstr("<th>initial_gyro_bias_deg_per_h</th><td>[2424.9, 271.8, -1.23e-05]</td>"));
+  EXPECT_THAT(html, HasSubstr("<th>output_epochs</th><td>300</td>"));
+  EXPECT_THAT(html, HasSubstr("<th>health.healthy</th><td>yes</td>"));
+  std::string text = html;
+  for (size_t p = text.find("base64,"); p != std::string::npos; p = text.find("base64,", p + 1)) {
+    const size_t end = text.find('"', p);
+    text.erase(p + 7, end - p - 7);
+  }
+  EXPECT_FALSE(std::regex_search(text, std::regex("[0-9]\\.[0-9]{5,}"))) << "an unrounded number in report.html";
+  // The outage window table: window numbers as integers, TOW with one decimal.
+  EXPECT_THAT(html, HasSubstr("<tr><td>1</td><td>225100.0</td><td>3.0</td><td>1.20</td>"));
   EXPECT_THAT(html, Not(HasSubstr("src=\"http")));  // nothing fetched from the network
   EXPECT_THAT(html, Not(HasSubstr("src=\"file")));
 }
