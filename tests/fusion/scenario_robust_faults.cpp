@@ -55,8 +55,13 @@ constexpr double kOutage_s = 600.0;             // issue 11: 10 minutes without 
 constexpr double kMaxRmsNoFault_m = 0.98 * 1.2;
 constexpr double kMaxFirstEpochNoFault_m = 8.53 * 1.2;
 constexpr double kMaxAfterFirstSecondNoFault_m = 2.29 * 1.2;
-constexpr double kMaxRmsWithFault_m = 2.5;      // a handled fault costs little accuracy
-constexpr double kMaxErrorAfterRecovery_m = 5.0;// error from 60 s after a recovery / the end of an outage
+// Bounds of the fault cases: the figure measured on 2026-12-05 (quoted at each test) times kMargin, which covers
+// compiler/platform rounding of a run whose decisions (w-tests, re-initialization epochs) sit near thresholds
+// (docs/conventions.md "Test bounds"); the issue's targets (2.5 m RMS with a handled fault, 5 m from 60 s after a
+// recovery) are far looser and checked as well where they apply.
+constexpr double kMargin = 1.25;
+constexpr double kMaxRmsWithFault_m = 2.5;      // issue 11: a handled fault costs little accuracy
+constexpr double kMaxErrorAfterRecovery_m = 5.0;// issue 11: error from 60 s after a recovery / the end of an outage
 constexpr double kRecoveryTime_s = 60.0;
 constexpr double kMaxOutputGap_s = 1.0 + 1e-6;  // 1 Hz output
 constexpr double kMaxErrorUndifferenced_m = 10.0;
@@ -207,6 +212,7 @@ TEST(RobustImuFault, ClippedGyroRunsAreReconstructedAndTheSigmaStaysHonest) {
     bool repair, accel_scale;
   };
   std::map<std::string, Errors> got;
+  double max_added_deg = 0.0;
   for (const Case c : {Case{"repair", true, false}, Case{"no repair", false, false}, Case{"repair + accel scale", true, true},
                        Case{"no repair + accel scale", false, true}}) {
     fusion::EngineOptions o = w.options;
@@ -221,6 +227,7 @@ TEST(RobustImuFault, ClippedGyroRunsAreReconstructedAndTheSigmaStaysHonest) {
                 c.name, e.rms, 100.0 * e.inside_3sigma, r->summary.saturated_runs, r->summary.saturated_runs_reconstructed,
                 r->summary.saturation_max_added_deg);
     if (c.repair) {
+      max_added_deg = r->summary.saturation_max_added_deg;
       EXPECT_GT(r->summary.saturated_runs, 250);
       EXPECT_EQ(r->summary.saturated_runs_reconstructed, r->summary.saturated_runs);
       EXPECT_GT(r->summary.saturated_samples, 2000);
@@ -229,15 +236,17 @@ TEST(RobustImuFault, ClippedGyroRunsAreReconstructedAndTheSigmaStaysHonest) {
     }
     got[c.name] = e;
   }
-  // Measured: 0.94 m / 100 % with the repair, 1.24 m / 78 % without; with accelerometer scale states 1.03 m / 100 %
-  // against 3.76 m / 20 %. The unclipped walk (gyro range 2000 °/s): 0.93 m / 100 %.
-  EXPECT_LT(got["repair"].rms, 1.05);
+  // Measured 2026-12-05: 0.91 m / 100 % with the repair, 1.20 m / 81 % without; with accelerometer scale states
+  // 0.95 m / 100 % against 4.09 m / 19.5 %; largest added angle 10.4° (297 runs).
+  EXPECT_LT(got["repair"].rms, 0.91 * kMargin);
   EXPECT_GE(got["repair"].inside_3sigma, 0.97);
   EXPECT_GT(got["no repair"].rms, got["repair"].rms + 0.15);
   EXPECT_LT(got["no repair"].inside_3sigma, 0.9);
-  EXPECT_LT(got["repair + accel scale"].rms, 1.2);
+  EXPECT_LT(got["repair + accel scale"].rms, 0.95 * kMargin);
   EXPECT_GE(got["repair + accel scale"].inside_3sigma, 0.97);
   EXPECT_GT(got["no repair + accel scale"].rms, 2.0);
+  EXPECT_GT(max_added_deg, 10.4 / kMargin);
+  EXPECT_LT(max_added_deg, 10.4 * kMargin);
 }
 
 TEST(RobustGnssFault, ReceiverClockJumpOf1msResetsTheClock) {
@@ -253,8 +262,11 @@ TEST(RobustGnssFault, ReceiverClockJumpOf1msResetsTheClock) {
   const Errors e = errors(w, *r, t_jump);
   std::printf("[ robust ] 1 ms clock jump: RMS %.2f m, max after the jump %.2f m, %ld clock resets\n", e.rms, e.max_from,
               r->summary.clock_resets);
+  // Measured 2026-12-05: RMS 0.97 m, max after the jump 1.33 m, 1 clock reset.
   EXPECT_GE(r->summary.clock_resets, 1);
-  EXPECT_LT(e.rms, kMaxRmsWithFault_m);
+  EXPECT_LE(r->summary.clock_resets, 2);
+  EXPECT_LT(e.rms, std::min(kMaxRmsWithFault_m, 0.97 * kMargin));
+  EXPECT_LT(e.max_from, 1.33 * kMargin);
   EXPECT_TRUE(r->summary.covariance_healthy) << r->summary.health_message;
   expect_accounting(in, r->summary);
 }
@@ -281,8 +293,12 @@ TEST(RobustGnssFault, PseudorangeBlunderOf300mOnOneSatelliteIsRejected) {
   const long faults = count_of(r->summary.code_used_rejected, "innovation_fault");
   std::printf("[ robust ] 300 m blunder on %ld epochs: %ld code rejections, RMS %.2f m, max after %.2f m\n", blundered,
               faults, e.rms, e.max_from);
+  // Measured 2026-12-05: 113 code rejections (the 60 blundered measurements and ones of the clean walk, whose
+  // baseline rejects some too), RMS 0.94 m, max after the blunder starts 0.94 m.
   EXPECT_GE(faults, blundered);
-  EXPECT_LT(e.rms, kMaxRmsWithFault_m);
+  EXPECT_LE(faults, static_cast<long>(113 * kMargin));
+  EXPECT_LT(e.rms, std::min(kMaxRmsWithFault_m, 0.94 * kMargin));
+  EXPECT_LT(e.max_from, 0.94 * kMargin);
   expect_accounting(in, r->summary);
 }
 
@@ -336,10 +352,11 @@ TEST(RobustGnssFault, SmallPersistentBiasIsFoundOverConsecutiveEpochs) {
   std::printf("[ robust ] %.1f m bias (0.6 MDB) on %s for 60 s: rejected %.0f %% of its epochs by the single-epoch "
               "test, %.0f %% with the 4-epoch window (%ld persistent-fault rejections)\n",
               bias_m, bad.to_string().c_str(), 100.0 * off, 100.0 * on, persistent_on);
-  EXPECT_LT(off, 0.1);
-  EXPECT_GT(on, 0.2);
+  // Measured 2026-12-05: 3 % single-epoch, 32 % with the window, 120 persistent-fault rejections.
+  EXPECT_LT(off, 0.03 * 2.0);  // a fraction of 60 epochs: one epoch is 1.7 %, so 2× rather than kMargin
+  EXPECT_GT(on, 0.32 / kMargin);
   EXPECT_EQ(persistent_off, 0);
-  EXPECT_GT(persistent_on, 10);
+  EXPECT_GT(persistent_on, static_cast<long>(120 / kMargin));
 }
 
 TEST(RobustGnssFault, MissingEphemerisOfOneSatelliteIsCountedAndTheRestUsed) {
@@ -352,8 +369,9 @@ TEST(RobustGnssFault, MissingEphemerisOfOneSatelliteIsCountedAndTheRestUsed) {
   const Errors e = errors(w, *r, GpsTime{});
   const long missing = count_of(r->summary.code_used_rejected, "no_ephemeris");
   std::printf("[ robust ] no ephemeris for one satellite: %ld measurements without, RMS %.2f m\n", missing, e.rms);
-  EXPECT_GT(missing, 100);
-  EXPECT_LT(e.rms, kMaxRmsWithFault_m);
+  // Measured 2026-12-05: every rover epoch (205) carries the satellite without ephemeris; RMS 0.79 m.
+  EXPECT_EQ(missing, e.n);
+  EXPECT_LT(e.rms, std::min(kMaxRmsWithFault_m, 0.79 * kMargin));
   expect_accounting(in, r->summary);
 }
 
@@ -368,8 +386,10 @@ TEST(RobustGnssFault, BaseThatStopsIsReportedAndTheRunContinues) {
   const auto& s = r->summary;
   std::printf("[ robust ] base stops at mid-walk: %ld rover epochs undifferenced, RMS %.2f m, max after %.2f m\n",
               s.gnss_epochs_undifferenced_no_base, e.rms, e.max_from);
+  // Measured 2026-12-05: 73 rover epochs undifferenced, RMS 1.06 m, max after the stop 2.00 m.
   EXPECT_GT(s.gnss_epochs_undifferenced_no_base, 30);  // processed undifferenced (broadcast clock, Klobuchar, Saastamoinen)
-  EXPECT_LT(e.max_from, kMaxErrorUndifferenced_m);
+  EXPECT_LT(e.max_from, std::min(kMaxErrorUndifferenced_m, 2.00 * kMargin));
+  EXPECT_LT(e.rms, 1.06 * kMargin);
   EXPECT_TRUE(s.covariance_healthy) << s.health_message;
   ASSERT_FALSE(r->epochs.empty());
   EXPECT_LE(w.sim.imu.back().t - r->epochs.back().t, kMaxOutputGap_s);  // the solution goes on to the end
@@ -404,7 +424,9 @@ TEST(RobustHealth, DivergenceFromImuGarbageIsReportedAndReinitializedFromGnss) {
   EXPECT_THAT(events, HasSubstr("re-initialized at"));
   EXPECT_THAT(s.smoother_message, HasSubstr("not smoothed: the filter was re-initialized"));
   EXPECT_TRUE(r->smoothed.empty());
-  EXPECT_LT(e.max_from, kMaxErrorAfterRecovery_m);
+  // Measured 2026-12-05: 1 re-initialization, max error from 60 s after 1.39 m.
+  EXPECT_LE(s.reinitializations, 2);
+  EXPECT_LT(e.max_from, std::min(kMaxErrorAfterRecovery_m, 1.39 * kMargin));
   EXPECT_GT(count_of(s.imu_skipped, "filter_diverged"), 0);
   expect_accounting(in, s);
 }
@@ -438,9 +460,11 @@ TEST(RobustHealth, ConfidentWrongPositionIsCaughtByImplausibleInnovationsAndRein
               "%.2f m\n%s",
               s.reinitializations, e.max_from, events.c_str());
   EXPECT_FALSE(s.covariance_healthy);
+  // Measured 2026-12-05: 1 re-initialization, max error from 60 s after the first 1.05 m.
   EXPECT_THAT(events, HasSubstr("innovations implausible"));
   EXPECT_GE(s.reinitializations, 1);
-  EXPECT_LT(e.max_from, kMaxErrorAfterRecovery_m);
+  EXPECT_LE(s.reinitializations, 2);
+  EXPECT_LT(e.max_from, std::min(kMaxErrorAfterRecovery_m, 1.05 * kMargin));
   expect_accounting(in, s);
 }
 
@@ -491,8 +515,14 @@ TEST(RobustGnssFault, TenMinutesWithoutSatellitesBridgedByInsAndRecovered) {
               "%.1f m), max from 60 s after %.2f m, %d re-initializations\n",
               after_outage_start.max_from, sd_max, e.max_from, r->summary.reinitializations);
   for (size_t k = 1; k < r->epochs.size(); ++k) ASSERT_LE(r->epochs[k].t - r->epochs[k - 1].t, kMaxOutputGap_s);
-  EXPECT_LT(e.max_from, kMaxErrorAfterRecovery_m);
-  EXPECT_GT(sd_max, 1.0);  // the filter knows it is coasting
+  // Measured 2026-12-05: max error from the outage on 2.3 m with a horizontal σ of up to 3.1 m, max from 60 s after
+  // the outage 1.75 m, 0 re-initializations.
+  EXPECT_LT(after_outage_start.max_from, 2.3 * kMargin);
+  EXPECT_LT(after_outage_start.max_from, 3.0 * sd_max);  // inside the filter's own 3σ
+  EXPECT_LT(e.max_from, std::min(kMaxErrorAfterRecovery_m, 1.75 * kMargin));
+  EXPECT_GT(sd_max, 3.1 / kMargin);  // the filter knows it is coasting
+  EXPECT_LT(sd_max, 3.1 * kMargin);
+  EXPECT_EQ(r->summary.reinitializations, 0);
   expect_accounting(in, r->summary);
 }
 
