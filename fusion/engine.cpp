@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // The engine's entry point (fusion/engine.hpp): checks the inputs, runs the stance detector, initializes (the first
 // still period levels the IMU and may give the gyro bias; position from the configuration or the first GNSS epoch
-// solution; heading from the configuration or from motion) and runs the forward pass with the smoother. The parts:
+// solution; heading from the configuration, the magnetometer or motion) and runs the forward pass with the smoother. The parts:
 // fusion/error_state_filter (state, covariance), fusion/gnss_update and fusion/fault_detection (GNSS rows, w-test),
 // fusion/stance_updates (ZUPT, ZARU, step velocity), fusion/initialization, fusion/forward_runner (the pass).
 #include "fusion/engine.hpp"
 
+#include <fmt/format.h>
+
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -96,7 +99,23 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
   // Heading: configured, else from motion (INS/ZUPT track with yaw 0 fitted to the GNSS epoch solutions).
   double yaw0 = 0.0;
   EngineOptions opt = o;
-  if (o.initial_yaw_rad) {
+  if (o.heading_from_magnetometer) {
+    if (!in.mag_b || in.mag_b->size() != samples.size()) {
+      return make_error("heading from the magnetometer needs one magnetometer vector per IMU sample (got " +
+                        std::to_string(in.mag_b ? in.mag_b->size() : 0) + " for " + std::to_string(samples.size()) +
+                        " samples)");
+    }
+    Vector3d m_b = Vector3d::Zero();
+    for (size_t k = s0; k < s1; ++k) m_b += (*in.mag_b)[k];
+    m_b /= static_cast<double>(s1 - s0);
+    if (!m_b.allFinite() || m_b.norm() == 0.0) return make_error("heading from the magnetometer: no field measured");
+    yaw0 = ins::heading_from_magnetometer(m_b, level->roll, level->pitch, o.magnetic_declination_rad);
+    const Vector3d m_level = R_n_b_from_euler(level->roll, level->pitch, 0.0) * m_b;  // yaw-free, z down
+    sum.magnetometer_field_norm = m_b.norm();
+    sum.magnetometer_dip_deg = std::atan2(m_level.z(), m_level.head<2>().norm()) * kRadToDeg;
+    how += fmt::format("; heading from the magnetometer ({:.1f} deg incl. declination {:.1f} deg; field dip {:.1f} deg)",
+                       yaw0 * kRadToDeg, o.magnetic_declination_rad * kRadToDeg, sum.magnetometer_dip_deg);
+  } else if (o.initial_yaw_rad) {
     yaw0 = *o.initial_yaw_rad;
     how += "; heading from configuration";
   } else if (tc) {

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <limits>
 #include <functional>
 #include <map>
 #include <optional>
@@ -54,6 +55,10 @@ struct EngineOptions {
   // Initial state.
   std::optional<Eigen::Vector3d> initial_position_e;  ///< IMU position [m] ECEF (ins mode: required)
   std::optional<double> initial_yaw_rad;              ///< else heading from motion (tc) / error (ins)
+  /// Initial yaw from EngineInputs::mag_b averaged over the levelling window, levelled with its roll and pitch,
+  /// plus magnetic_declination_rad (east positive); exclusive with initial_yaw_rad (docs/fusion.md §8.1).
+  bool heading_from_magnetometer = false;
+  double magnetic_declination_rad = 0.0;
   double heading_init_distance_m = 30.0;              ///< walked GNSS distance used to find the heading
   double initial_sigma_pos_m = 5.0;
   double initial_sigma_vel_mps = 0.1;
@@ -143,6 +148,9 @@ struct EngineInputs {
   const std::vector<gnss::ObsEpoch>* base = nullptr;  ///< optional (SD)
   /// Stance labels, one 0/1 per IMU sample (io::ImuLog::stance): required by `zupt.detector: labels`.
   const std::vector<uint8_t>* stance_labels = nullptr;
+  /// Magnetic field in the body frame, one per IMU sample (io::ImuLog::mag_b, any unit): required by
+  /// EngineOptions::heading_from_magnetometer.
+  const std::vector<Eigen::Vector3d>* mag_b = nullptr;
   /// GNSS epochs whose time is in this set are skipped (outage masks); satellites of partial outages removed.
   std::function<void(gnss::ObsEpoch&)> gnss_mask;
   /// Test hook: called at the end of every mechanization step with the step's end time (GPST), after its updates
@@ -199,6 +207,10 @@ struct EngineSummary {
   std::optional<GpsTime> heading_init_end;  ///< end of the heading-from-motion span (tc without a configured yaw)
   double heading_init_distance_m = 0.0;     ///< distance the INS/ZUPT track walked for it [m] (docs/fusion.md §8)
   double initial_yaw_deg = 0.0;
+  /// heading_from_magnetometer: the levelling window's mean field, its norm (in the unit of mag_b) and dip below the
+  /// horizontal [deg]; NaN otherwise.
+  double magnetometer_field_norm = std::numeric_limits<double>::quiet_NaN();
+  double magnetometer_dip_deg = std::numeric_limits<double>::quiet_NaN();
   /// Gyro bias the filter started from [deg/h] (body axes): the first still period's mean rate minus Earth rate when
   /// that window is >= 2 s and consistent with the turn-on bias (docs/ins.md eq. 6.1), else zero.
   Eigen::Vector3d initial_gyro_bias_deg_per_h = Eigen::Vector3d::Zero();

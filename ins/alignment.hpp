@@ -49,8 +49,8 @@ double still_gyro_bias_d2(const Levelling& lv, double gyro_bias_initial_radps, d
 /// (R_e_b = R_e_n(lat, lon) R_n_b(roll, pitch, yaw)).
 NavState nav_state_at_rest(GpsTime t, const Eigen::Vector3d& p_eb_e, double roll, double pitch, double yaw);
 
-/// Heading [rad] from a magnetometer vector m_b (not yet wired to a command: issue 36 adds the magnetometer column and
-/// the run key) (any unit) at the given roll/pitch [rad] plus the magnetic
+/// Heading [rad] from a magnetometer vector m_b (any unit; `initial.heading: magnetometer`, fusion/engine.cpp) at the
+/// given roll/pitch [rad] plus the magnetic
 /// declination [rad] (east positive): yaw = atan2(-m_y', m_x') + declination with m' levelled into the n-frame.
 double heading_from_magnetometer(const Eigen::Vector3d& m_b, double roll, double pitch, double declination_rad);
 

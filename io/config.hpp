@@ -116,6 +116,10 @@ struct ZuptConfig {
 /// `initial:` section (pednav run).
 struct InitialConfig {
   std::optional<double> yaw_rad;                 ///< key yaw_deg; absent: heading from motion (tc)
+  /// key heading: magnetometer — the initial yaw from the magnetometer columns of imu.format over the levelling
+  /// window (docs/fusion.md §8.1); "auto" (default): yaw_deg when given, else heading from motion (tc).
+  bool heading_from_magnetometer = false;
+  double declination_rad = 0.0;                  ///< key declination_deg: magnetic declination, east positive
   std::optional<Eigen::Vector3d> position_e;     ///< key position_ecef_m or lat_deg/lon_deg/h_m
   double heading_init_distance_m = 30.0;
   double sigma_position_m = 5.0;

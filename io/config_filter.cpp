@@ -67,6 +67,18 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
       i.number("yaw_deg", y, false, -360.0, 360.0);
       c.yaw_rad = y * kDegToRad;
     }
+    std::string heading = "auto";
+    i.choice("heading", heading, {"auto", "magnetometer"});
+    c.heading_from_magnetometer = heading == "magnetometer";
+    if (c.heading_from_magnetometer && c.yaw_rad) {
+      i.problem("heading", "magnetometer and yaw_deg both set the initial heading: keep one");
+    }
+    double decl_deg = c.declination_rad * kRadToDeg;
+    i.number("declination_deg", decl_deg, false, -180.0, 180.0);
+    c.declination_rad = decl_deg * kDegToRad;
+    if (i.has("declination_deg") && !c.heading_from_magnetometer) {
+      i.problem("declination_deg", "only used with heading: magnetometer");
+    }
     if (i.has("position_ecef_m")) {
       Eigen::Vector3d p = Eigen::Vector3d::Zero();
       i.vector3("position_ecef_m", p);

@@ -92,6 +92,18 @@ void read_imu_format(YamlMap& m, ImuFormat& out) {
     YamlMap st = m.map("stance");
     st.integer("column", out.stance_column, true, 0, 10000);
   }
+  if (m.has("mag")) {
+    YamlMap mg = m.map("mag");
+    read_columns(mg, "columns", out.mag_columns);
+    if (!mg.has("columns")) mg.problem("columns", "required key is missing");
+    std::string unit = "ut";
+    mg.choice("unit", unit, {"ut", "gauss", "nt", "mgauss"});
+    out.mag_scale_to_ut = unit == "gauss" ? 100.0 : unit == "mgauss" ? 0.1 : unit == "nt" ? 1e-3 : 1.0;
+    mg.vector3("signs", out.mag_signs);
+    for (int i = 0; i < 3; ++i) {
+      if (std::abs(out.mag_signs(i)) != 1.0) m.problem("mag", "signs must each be 1 or -1");
+    }
+  }
   for (int i = 0; i < 3; ++i) {
     if (std::abs(out.gyro_signs(i)) != 1.0) m.problem("gyro", "signs must each be 1 or -1");
     if (std::abs(out.accel_signs(i)) != 1.0) m.problem("accel", "signs must each be 1 or -1");

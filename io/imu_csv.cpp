@@ -75,6 +75,11 @@ std::vector<std::string> ImuFormat::problems() const {
     }
   }
   if (stance_column < -1) p.push_back("stance.column: column indices are 0-based and >= 0");
+  if (mag_columns[0] >= 0) {
+    for (int c : mag_columns)
+      if (c < 0) p.push_back("mag.columns: column indices are 0-based and >= 0");
+    if (!(mag_scale_to_ut > 0.0)) p.push_back("mag.unit: scale must be > 0");
+  }
   if (!(max_gap_s > 0.0)) p.push_back("max_gap_s must be > 0");
   if (header_lines < 0) p.push_back("header_lines must be >= 0");
   return p;
@@ -93,8 +98,15 @@ Expected<ImuLog> parse_imu_csv(const char* data, size_t size, const std::string&
   for (int c : fmt.accel_columns) max_col = std::max(max_col, c);
   const bool labels = fmt.stance_column >= 0;
   if (labels) max_col = std::max(max_col, fmt.stance_column);
+  const bool mag = fmt.mag_columns[0] >= 0;
+  if (mag) {
+    for (int c : fmt.mag_columns) max_col = std::max(max_col, c);
+  }
   std::vector<signed char> slot(max_col + 1, -1);
   if (labels) slot[fmt.stance_column] = 7;
+  if (mag) {
+    for (int i = 0; i < 3; ++i) slot[fmt.mag_columns[i]] = static_cast<signed char>(8 + i);
+  }
   if (use_time) slot[fmt.time_column] = 0;
   for (int i = 0; i < 3; ++i) {
     slot[fmt.gyro_columns[i]] = static_cast<signed char>(1 + i);
@@ -114,7 +126,7 @@ Expected<ImuLog> parse_imu_csv(const char* data, size_t size, const std::string&
   long line = 0;
   std::string first_bad_reason;
   long data_index = 0;
-  double vals[8];
+  double vals[11];
   while (p < end) {
     const char* le = static_cast<const char*>(std::memchr(p, '\n', static_cast<size_t>(end - p)));
     if (!le) le = end;
@@ -216,6 +228,11 @@ Expected<ImuLog> parse_imu_csv(const char* data, size_t size, const std::string&
     s.f_ib_b = a_s;
     log.samples.push_back(s);
     if (labels) log.stance.push_back(vals[7] != 0.0 ? 1 : 0);
+    if (mag) {
+      log.mag_b.push_back(fmt.R_b_s * Eigen::Vector3d(vals[8] * fmt.mag_signs(0), vals[9] * fmt.mag_signs(1),
+                                                     vals[10] * fmt.mag_signs(2)) *
+                          fmt.mag_scale_to_ut);
+    }
     raw_gyro.push_back(g_s);
     raw_acc.push_back(a_s);
     lines.push_back(line);

@@ -39,6 +39,11 @@ struct ImuFormat {
   /// Optional stance-label column (0 = moving, 1 = stance; e.g. reference or oracle zero-velocity labels), read
   /// into ImuLog::stance for `zupt.detector: labels`; -1 = none.
   int stance_column = -1;
+  /// Optional magnetometer columns (sensor axes, any unit: only the direction is used), read into ImuLog::mag_b in
+  /// the IMU body frame (same signs convention and mounting as the gyro); mag_columns[0] = -1: none.
+  std::array<int, 3> mag_columns{-1, -1, -1};
+  Eigen::Vector3d mag_signs = Eigen::Vector3d::Ones();
+  double mag_scale_to_ut = 1.0;  ///< µT per unit of the columns (key mag.unit: ut | gauss | nt | mgauss)
   double gyro_full_scale = 0.0;   ///< [rad/s] per axis, 0 = not checked
   double accel_full_scale = 0.0;  ///< [m/s^2] per axis, 0 = not checked
   // Checks.
@@ -82,6 +87,7 @@ struct ImuLogReport {
 struct ImuLog {
   std::vector<ins::ImuSample> samples;
   std::vector<uint8_t> stance;  ///< per kept sample 0/1 when the format has a stance column, else empty
+  std::vector<Eigen::Vector3d> mag_b;  ///< per kept sample, the magnetic field in the body frame [µT]; else empty
   ImuLogReport report;
 };
 

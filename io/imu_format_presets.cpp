@@ -44,6 +44,7 @@ header_lines: 1
 time: {base: relative, column: 0, unit: s}
 gyro: {columns: [4, 5, 6], unit: rad_per_s, signs: [1, 1, 1]}
 accel: {columns: [1, 2, 3], unit: g, signs: [1, 1, 1]}
+mag: {columns: [7, 8, 9], unit: gauss, signs: [1, 1, 1]}
 mounting_rpy_deg: [0, 0, 0]
 max_gap_s: 0.05
 )yaml"},

@@ -111,6 +111,8 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.zaru_gate_probability = c.zupt.zaru_gate_probability;
   o.initial_position_e = c.initial.position_e;
   o.initial_yaw_rad = c.initial.yaw_rad;
+  o.heading_from_magnetometer = c.initial.heading_from_magnetometer;
+  o.magnetic_declination_rad = c.initial.declination_rad;
   o.heading_init_distance_m = c.initial.heading_init_distance_m;
   o.initial_sigma_pos_m = c.initial.sigma_position_m;
   o.initial_sigma_vel_mps = c.initial.sigma_velocity_mps;
@@ -163,6 +165,7 @@ fusion::EngineInputs RunInputs::engine_inputs() const {
   fusion::EngineInputs in;
   in.imu = &imu.samples;
   if (!imu.stance.empty()) in.stance_labels = &imu.stance;
+  if (!imu.mag_b.empty()) in.mag_b = &imu.mag_b;
   if (rover) in.rover = &rover->epochs;
   if (nav) in.nav = &*nav;
   if (base) in.base = &base->epochs;
@@ -184,6 +187,10 @@ Expected<RunInputs> load_run_inputs(const RunConfig& c) {
   if (!imu) return imu.error();
   for (const auto& w : imu->report.warnings) spdlog::warn("{}: {}", c.imu.file, w);
   d.imu = std::move(*imu);
+  if (c.initial.heading_from_magnetometer && d.imu.mag_b.empty()) {
+    return make_error(c.source_file + ": initial.heading: magnetometer needs the magnetometer columns of imu.format "
+                                      "(mag: {columns: [i, j, k], unit: ut | gauss | nt | mgauss})");
+  }
   d.config = c;
   d.self_calibration = resolve_self_calibration(d.config, d.imu);
   if (d.self_calibration) {
@@ -302,6 +309,17 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
   j["initial_gyro_bias_deg_per_h"] = {sum.initial_gyro_bias_deg_per_h.x(), sum.initial_gyro_bias_deg_per_h.y(),
                                       sum.initial_gyro_bias_deg_per_h.z()};
   j["still_gyro_bias_d2"] = sum.still_gyro_bias_d2;
+  if (c.initial.heading_from_magnetometer) {
+    // The magnetometer columns are converted to µT by the reader (imu.format mag.unit).
+    j["magnetometer"] = {{"declination_deg", c.initial.declination_rad * kRadToDeg},
+                         {"field_ut", sum.magnetometer_field_norm},
+                         {"dip_deg", sum.magnetometer_dip_deg}};
+    if (!(sum.magnetometer_field_norm >= 22.0 && sum.magnetometer_field_norm <= 67.0)) {
+      spdlog::warn("{}: magnetometer field {:.1f} µT at the start is outside the Earth's 22-67 µT: a disturbed field "
+                   "(steel, electronics) or a wrong mag.unit; the initial heading may be off",
+                   c.imu.file, sum.magnetometer_field_norm);
+    }
+  }
   j["heading_fit_rms_m"] = sum.heading_fit_rms_m;
   if (sum.heading_init_end) {
     j["heading_init_distance_m"] = sum.heading_init_distance_m;

@@ -250,6 +250,82 @@ TEST(ImuCsv, StanceLabelColumnStaysAlignedAndOtherValuesAreBadRows) {
   EXPECT_THAT(cfg.error().message, HasSubstr("imu.format.stance.column"));
 }
 
+// Magnetometer columns (initial.heading: magnetometer): converted to µT, signed and mounted like the gyro, kept
+// aligned with the samples (a duplicate time drops its field too); a bad cell makes the row bad.
+TEST(ImuCsv, MagnetometerColumnsInMicroteslaInTheBodyFrameAlignedWithTheSamples) {
+  std::ostringstream os;
+  os << "t,gx,gy,gz,ax,ay,az,mx,my,mz\n";
+  for (int i = 0; i < 200; ++i) {
+    os << i * 0.01 << ",0,0,0,0,0,-9.80665,0.2," << 0.001 * i << ",0.4\n";
+    if (i == 50) os << i * 0.01 << ",0,0,0,0,0,-9.80665,9,9,9\n";  // duplicate time: dropped with its field
+  }
+  os << "2.0,0,0,0,0,0,-9.80665,0.2,x,0.4\n";
+  ImuFormat f = basic();
+  f.mag_columns = {7, 8, 9};
+  f.mag_signs = Eigen::Vector3d(1, -1, 1);
+  f.mag_scale_to_ut = 100.0;  // gauss
+  f.R_b_s = Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();  // (x, y, z) -> (-y, x, z)
+  auto log = parse(os.str(), f);
+  ASSERT_TRUE(log) << log.error().message;
+  ASSERT_EQ(log->samples.size(), 200u);
+  ASSERT_EQ(log->mag_b.size(), log->samples.size());
+  for (const int i : {0, 50, 51, 199}) {
+    // sensor (20, -0.1 i, 40) µT -> body (0.1 i, 20, 40) µT
+    EXPECT_NEAR(log->mag_b[static_cast<size_t>(i)].x(), 0.1 * i, 1e-9) << i;
+    EXPECT_NEAR(log->mag_b[static_cast<size_t>(i)].y(), 20.0, 1e-9) << i;
+    EXPECT_NEAR(log->mag_b[static_cast<size_t>(i)].z(), 40.0, 1e-9) << i;
+  }
+  EXPECT_EQ(log->report.bad_rows, 1);
+  std::string all;
+  for (const auto& w : log->report.warnings) all += w + "\n";
+  EXPECT_THAT(all, HasSubstr("imu.csv:203: column 8 is 'x' (expected a finite number)"));
+  EXPECT_TRUE(parse(os.str(), basic())->mag_b.empty());  // no mag columns in the format: nothing read
+  // In a config: units, three columns, signs.
+  auto cfg = parse_run_config(
+      "mode: ins\nimu:\n  file: a.csv\n  format:\n    gyro: {columns: [1, 2, 3]}\n    accel: {columns: [4, 5, 6]}\n"
+      "    mag: {columns: [7, 8, 9], unit: nt, signs: [1, 1, -1]}\n",
+      "cfg.yaml", "/d");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->imu.format.mag_columns[2], 9);
+  EXPECT_DOUBLE_EQ(cfg->imu.format.mag_scale_to_ut, 1e-3);
+  EXPECT_EQ(cfg->imu.format.mag_signs.z(), -1.0);
+  auto bad = parse_run_config(
+      "mode: ins\nimu:\n  file: a.csv\n  format:\n    gyro: {columns: [1, 2, 3]}\n    accel: {columns: [4, 5, 6]}\n"
+      "    mag: {columns: [7, 8], unit: tesla, signs: [1, 2, 1]}\n",
+      "cfg.yaml", "/d");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("imu.format.mag.columns: expected 3 column indices, got 2"));
+  EXPECT_THAT(bad.error().message, HasSubstr("imu.format.mag.unit: expected one of"));
+  EXPECT_THAT(bad.error().message, HasSubstr("imu.format.mag: signs must each be 1 or -1"));
+  auto missing = parse_run_config(
+      "mode: ins\nimu:\n  file: a.csv\n  format:\n    gyro: {columns: [1, 2, 3]}\n    accel: {columns: [4, 5, 6]}\n"
+      "    mag: {unit: ut}\n",
+      "cfg.yaml", "/d");
+  ASSERT_FALSE(missing);
+  EXPECT_THAT(missing.error().message, HasSubstr("imu.format.mag.columns: required key is missing"));
+}
+
+// initial.heading / declination_deg: one source of the initial heading.
+TEST(ImuConfig, MagnetometerHeadingKeys) {
+  const std::string base = "mode: ins\nimu:\n  file: a.csv\n  format: lord_sensorconnect\n  spec: gx5_25\n";
+  auto ok = parse_run_config(base + "initial: {lat_deg: 45, lon_deg: 0, h_m: 0, heading: magnetometer, declination_deg: -3.5}\n",
+                             "cfg.yaml", "/d");
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_TRUE(ok->initial.heading_from_magnetometer);
+  EXPECT_NEAR(ok->initial.declination_rad, -3.5 * kDegToRad, 1e-15);
+  EXPECT_EQ(ok->imu.format.mag_columns[0], 7);  // the LORD preset reads its magnetometer
+  EXPECT_DOUBLE_EQ(ok->imu.format.mag_scale_to_ut, 100.0);
+  auto both = parse_run_config(base + "initial: {heading: magnetometer, yaw_deg: 10}\n", "cfg.yaml", "/d");
+  ASSERT_FALSE(both);
+  EXPECT_THAT(both.error().message, HasSubstr("initial.heading: magnetometer and yaw_deg both set the initial heading"));
+  auto decl = parse_run_config(base + "initial: {yaw_deg: 10, declination_deg: 2}\n", "cfg.yaml", "/d");
+  ASSERT_FALSE(decl);
+  EXPECT_THAT(decl.error().message, HasSubstr("initial.declination_deg: only used with heading: magnetometer"));
+  auto value = parse_run_config(base + "initial: {heading: compass}\n", "cfg.yaml", "/d");
+  ASSERT_FALSE(value);
+  EXPECT_THAT(value.error().message, HasSubstr("initial.heading: expected one of"));
+}
+
 TEST(ImuFormatPresets, EmbeddedTextEqualsDatasetsFilesAndParses) {
   for (const auto& name : imu_format_preset_names()) {
     std::ifstream in(test::source_path("datasets/imu_formats/" + name + ".yaml"));
