@@ -24,8 +24,10 @@ void add_compare_command(CLI::App& app, Action& action) {
   cmd->add_option("--reference-format", *ref_format, "auto|csv|pos|nmea")->check(CLI::IsMember({"auto", "csv", "pos", "nmea"}));
   cmd->add_option("--nmea-quality", *qualities, "GGA fix qualities to keep, e.g. 4 (RTK fixed); default all valid");
   cmd->add_option("--nmea-date", args->reference_read.nmea_date, "UTC date YYYY-MM-DD if the NMEA has no RMC");
-  cmd->add_option("--align", *align, "none|start|best-fit-2d|best-fit-3d")
-      ->check(CLI::IsMember({"none", "start", "best-fit-2d", "best-fit-3d"}));
+  cmd->add_option("--align", *align,
+                  "none|start|start-pyshoe|best-fit-2d|best-fit-3d (start: direction to the first reference point 1 m "
+                  "out; start-pyshoe: PyShoe's align_plots, the first solution epoch 0.8 m out)")
+      ->check(CLI::IsMember({"none", "start", "start-pyshoe", "best-fit-2d", "best-fit-3d"}));
   cmd->add_option("--tolerance", args->compare.time_tolerance_s, "Time matching tolerance [s] (default 0.05)");
   cmd->add_flag("--loop", args->compare.loop, "The path is a closed loop: report closure and % of distance");
   cmd->add_option("--segment", args->segment_s, "Per-segment statistics: segment length [s] (default 120)")
@@ -36,7 +38,8 @@ void add_compare_command(CLI::App& app, Action& action) {
       args->solution_read.format = *io::parse_trajectory_format(*sol_format);
       args->reference_read.format = *io::parse_trajectory_format(*ref_format);
       args->reference_read.nmea_qualities = std::set<int>(qualities->begin(), qualities->end());
-      args->compare.align = *align == "start"         ? eval::Align::kStart
+      args->compare.align = *align == "start"          ? eval::Align::kStart
+                            : *align == "start-pyshoe" ? eval::Align::kStartPyshoe
                             : *align == "best-fit-2d" ? eval::Align::kBestFit2d
                             : *align == "best-fit-3d" ? eval::Align::kBestFit3d
                                                       : eval::Align::kNone;

@@ -127,11 +127,20 @@ Expected<Evaluation> compare(const Trajectory& sol, const Trajectory& ref, const
   }
 
   Evaluation ev;
-  if (o.align == Align::kStart) {
+  if (o.align == Align::kStart || o.align == Align::kStartPyshoe) {
     // Translate to the common start; rotate about the vertical so that the direction to the first reference point
-    // >= 1 m from the start agrees.
+    // >= 1 m from the start agrees (kStartPyshoe: the first solution epoch >= 0.8 m from the solution's start,
+    // else the epoch 1.5 s after the start).
     size_t k = 1;
-    while (k < r_enu.size() && (r_enu[k] - r_enu[0]).head<2>().norm() < 1.0) ++k;
+    if (o.align == Align::kStart) {
+      while (k < r_enu.size() && (r_enu[k] - r_enu[0]).head<2>().norm() < 1.0) ++k;
+    } else {
+      while (k < s_enu.size() && (s_enu[k] - s_enu[0]).head<2>().norm() < 0.8) ++k;
+      if (k == s_enu.size()) {
+        k = 1;
+        while (k < times.size() && times[k] - times[0] < 1.5) ++k;
+      }
+    }
     double yaw = 0.0;
     if (k < r_enu.size()) {
       const Eigen::Vector3d dr = r_enu[k] - r_enu[0], ds = s_enu[k] - s_enu[0];

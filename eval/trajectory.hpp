@@ -35,6 +35,9 @@ enum class Align {
   kNone,        ///< no alignment (both in ECEF)
   kStart,       ///< translate to a common start, rotate about the vertical to match the direction to the first
                 ///< reference point >= 1 m from the start
+  kStartPyshoe, ///< PyShoe's align_plots: translate to a common start, rotate about the vertical so that at the
+                ///< first matched epoch >= 0.8 m (horizontal) from the *solution's* start both point the same way
+                ///< (none within reach: the epoch 1.5 s after the start, PyShoe's sample 300 at 200 Hz)
   kBestFit2d,   ///< least-squares rotation about the vertical + 3D translation
   kBestFit3d,   ///< least-squares 3D rotation + translation (Horn/Umeyama, no scale)
 };

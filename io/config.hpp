@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/expected.hpp"
+#include "ins/calibration.hpp"
 #include "ins/hmm.hpp"
 #include "ins/imu_spec.hpp"
 #include "fusion/step_velocity.hpp"
@@ -84,6 +85,9 @@ struct ZuptConfig {
   /// `shoe_threshold: auto`: γ from the log's still floor of the statistic (ins::auto_shoe_threshold), with the
   /// gait-adaptive raise next to a swing unless its keys are set (docs/zupt.md §6); resolved at run time.
   bool shoe_threshold_auto = false;
+  /// key shoe_threshold_motion: with shoe_threshold: auto, γ = the statistic at rest + this allowance
+  /// (ins::AutoThresholdOptions::motion; docs/zupt.md §6)
+  double shoe_threshold_motion = ins::AutoThresholdOptions{}.motion;
   bool edge_s_given = false;               ///< zupt.edge_s was in the file (else `auto` may choose it)
   bool zaru_gate_given = false;            ///< zupt.zaru_gate_probability was in the file
   bool zaru_sigma_given = false;           ///< zupt.zaru_sigma_deg_per_s was in the file

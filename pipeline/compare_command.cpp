@@ -26,6 +26,7 @@ namespace {
 const char* align_name(eval::Align a) {
   switch (a) {
     case eval::Align::kStart: return "start";
+    case eval::Align::kStartPyshoe: return "start-pyshoe";
     case eval::Align::kBestFit2d: return "best-fit-2d";
     case eval::Align::kBestFit3d: return "best-fit-3d";
     default: return "none";

@@ -50,7 +50,9 @@ std::optional<SelfCalibration> resolve_self_calibration(io::RunConfig& c, const 
   if (c.zupt.shoe_threshold_auto) {
     s.threshold_auto = true;
     const ins::ZuptDetectorOptions zo = io::zupt_detector_options(c.zupt);
-    s.threshold = ins::auto_shoe_threshold(ins::shoe_statistic(log.samples, zo), s.calibration);
+    ins::AutoThresholdOptions ao;
+    ao.motion = c.zupt.shoe_threshold_motion;
+    s.threshold = ins::auto_shoe_threshold(ins::shoe_statistic(log.samples, zo), s.calibration, ao);
     c.zupt.shoe_threshold = s.threshold.threshold;
     c.zupt.shoe_threshold_auto = false;
     if (c.zupt.shoe_adaptive_factor <= 0.0) {

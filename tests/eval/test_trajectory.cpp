@@ -107,13 +107,46 @@ TEST(Compare, AlignmentRecoversRotationAndTranslation) {
   auto none = compare(sol, ref, o);
   ASSERT_FALSE(none);
   EXPECT_THAT(none.error().message, HasSubstr("local frame"));
-  for (Align a : {Align::kStart, Align::kBestFit2d, Align::kBestFit3d}) {
+  for (Align a : {Align::kStart, Align::kStartPyshoe, Align::kBestFit2d, Align::kBestFit3d}) {
     o.align = a;
     auto ev = compare(sol, ref, o);
     ASSERT_TRUE(ev) << ev.error().message;
     EXPECT_LT(ev->horizontal_max_m, 1e-6) << static_cast<int>(a);
     EXPECT_LT(std::abs(ev->vertical_mean_m), 1e-6);
   }
+}
+
+// start vs start-pyshoe: `start` takes the direction at the first *reference* point >= 1 m out, `start-pyshoe`
+// (PyShoe's align_plots) at the first *solution* epoch >= 0.8 m out, else 1.5 s after the start.
+TEST(Compare, StartAlignmentsPickTheirEpochs) {
+  const GpsTime t0 = GpsTime::from_week_tow(2021, 400000.0);
+  auto track = [&](const std::vector<Eigen::Vector2d>& en, Frame f) {
+    Trajectory t;
+    t.frame = f;
+    for (size_t i = 0; i < en.size(); ++i) {
+      const Eigen::Vector3d enu(en[i].x(), en[i].y(), 0.0);
+      t.points.push_back({t0.plus_s(static_cast<double>(i)),
+                          f == Frame::kEcef ? ecef_from_ned(Eigen::Vector3d(enu.y(), enu.x(), 0.0), kOrigin_e) : enu});
+    }
+    return t;
+  };
+  const Trajectory ref = track({{0, 0}, {1, 0}, {2, 0}, {3, 0}, {4, 0}}, Frame::kLocalEnu);
+  const Trajectory sol = track({{0, 0}, {0.5, 0}, {0.7, 0.7}, {2, 0}, {3, 0}}, Frame::kEcef);
+  auto yaw_deg = [](const Evaluation& ev) { return std::atan2(ev.R_align(1, 0), ev.R_align(0, 0)) * kRadToDeg; };
+  CompareOptions o;
+  o.align = Align::kStart;
+  auto a = compare(sol, ref, o);
+  ASSERT_TRUE(a) << a.error().message;
+  EXPECT_NEAR(yaw_deg(*a), 0.0, 1e-6);  // reference point 1: (1, 0) against (0.5, 0)
+  o.align = Align::kStartPyshoe;
+  auto b = compare(sol, ref, o);
+  ASSERT_TRUE(b) << b.error().message;
+  EXPECT_NEAR(yaw_deg(*b), -45.0, 1e-6);  // solution epoch 2 (0.99 m out): (2, 0) against (0.7, 0.7)
+  // A solution that never gets 0.8 m out: the epoch 1.5 s after the start (epoch 2).
+  const Trajectory stay = track({{0, 0}, {0.1, 0}, {0.3, 0.3}, {0.2, 0}, {0.1, 0}}, Frame::kEcef);
+  auto c = compare(stay, ref, o);
+  ASSERT_TRUE(c) << c.error().message;
+  EXPECT_NEAR(yaw_deg(*c), -45.0, 1e-6);
 }
 
 TEST(Compare, LoopClosure) {
