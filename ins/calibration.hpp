@@ -124,11 +124,18 @@ ImuSpec spec_from_calibration(const ImuCalibration& calibration, const AutoSpecO
 /// rest is the rest_quantile of T over the calibration's still periods (the sensor's own noise in the units of the
 /// configured σ's: a noisy sensor at a high rate sits far above a quiet one), or the 5th percentile of T when the log
 /// has no still period. The allowance is the motion a stance may keep (a foot rolling over its sole) in the same
-/// units: with the default σ's (0.5 m/s², 0.1 rad/s) 1.5 admits about 0.12 rad/s of steady rotation.
+/// units: with the default σ's (0.5 m/s², 0.1 rad/s) 2.5 admits about 0.16 rad/s of steady rotation.
 struct AutoThresholdOptions {
   double rest_quantile = 0.99;
-  double motion = 1.5;  ///< chosen on the tuning subset of the PyShoe trials (docs/results.md)
+  /// Chosen with kAutoAdaptiveFactor and kAutoAdaptiveMinPeakDegPerS by leave-one-session-out cross-validation on
+  /// the 24 PyShoe trials (scripts/pyshoe_loso; docs/zupt.md §6, docs/results.md "Out of the box").
+  double motion = 2.5;
 };
+/// The gait-adaptive raise (docs/zupt.md §1) that `zupt.shoe_threshold: auto` switches on unless its keys are given:
+/// threshold max(γ, factor × the smallest T within ±window/2) next to a swing whose peak rate reaches the minimum.
+inline constexpr double kAutoAdaptiveFactor = 4.0;
+inline constexpr double kAutoAdaptiveWindowS = 1.0;
+inline constexpr double kAutoAdaptiveMinPeakDegPerS = 360.0;
 struct AutoThreshold {
   double rest = 0.0;       ///< T at rest (the rest_quantile over the still periods)
   double threshold = 0.0;  ///< γ

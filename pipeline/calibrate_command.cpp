@@ -61,9 +61,10 @@ std::string calibration_yaml(const SelfCalibration& s, const std::string& imu_fi
                    s.threshold.threshold, s.threshold.rest,
                    s.threshold.from_still ? "99th percentile over the still periods" : "5th percentile: no still period",
                    s.threshold.threshold - s.threshold.rest);
-  y += "  shoe_adaptive_factor: 3   # raised to 3 x the local minimum next to a swing (docs/zupt.md §1)\n";
-  y += "  shoe_adaptive_window_s: 1.0\n";
-  y += "  shoe_adaptive_min_peak_rate_deg_per_s: 180\n";
+  y += fmt::format("  shoe_adaptive_factor: {:g}   # raised to {:g} x the local minimum next to a swing (docs/zupt.md §1)\n",
+                   ins::kAutoAdaptiveFactor, ins::kAutoAdaptiveFactor);
+  y += fmt::format("  shoe_adaptive_window_s: {:g}\n", ins::kAutoAdaptiveWindowS);
+  y += fmt::format("  shoe_adaptive_min_peak_rate_deg_per_s: {:g}\n", ins::kAutoAdaptiveMinPeakDegPerS);
   y += fmt::format("# gravity: {} ({} up, {:.1f} deg tilt, |f| = {:.4f} m/s^2); gait: {:.1f} strides/min, stance "
                    "share {:.2f}, peak rate {:.0f} deg/s (p99)\n",
                    c.gravity_estimated ? "measured" : "not measured", c.up_axis.empty() ? "?" : c.up_axis, c.tilt_deg,

@@ -15,15 +15,13 @@ nlohmann::json vec(const Eigen::Vector3d& v, double scale) {
   return nlohmann::json::array({v.x() * scale, v.y() * scale, v.z() * scale});
 }
 
-// Gait-adaptive raise of the auto threshold next to a swing (docs/zupt.md §1, §6) unless configured: the values of
-// the GX5-25 configuration, chosen on the tuning subset of the PyShoe trials (docs/results.md).
-constexpr double kAutoAdaptiveFactor = 3.0;
-constexpr double kAutoAdaptiveWindowS = 1.0;
-constexpr double kAutoAdaptiveMinPeakRadps = 180.0 * kDegToRad;
+// Gait-adaptive raise of the auto threshold next to a swing (docs/zupt.md §1, §6) unless configured:
+// ins::kAutoAdaptiveFactor, ins::kAutoAdaptiveWindowS, ins::kAutoAdaptiveMinPeakDegPerS.
 // ... and, unless configured, every stance sample (no edge skip) with the ZARU innovation gate (docs/fusion.md §5.3):
 // an auto threshold keeps the slow rolling of a foot in its stances, which a ZARU would turn into a gyro bias.
 // Chosen on the tuning subset (median pednav / PyShoe per-trial tuned): 0.89x with both, 0.98x with the gate only,
-// 2.83x with the edges only, 1.74x with neither (measured 2026-12-05, scripts/pyshoe_cv --tuning-only).
+// 2.83x with the edges only, 1.74x with neither (measured 2026-12-05, scripts/pyshoe_cv --tuning-only, with the first
+// auto knobs 1.5 / 3 / 180 °/s; kept when scripts/pyshoe_loso re-chose those).
 constexpr double kAutoEdgeS = 0.0;
 constexpr double kAutoZaruGateProbability = 0.999;
 
@@ -56,9 +54,11 @@ std::optional<SelfCalibration> resolve_self_calibration(io::RunConfig& c, const 
     c.zupt.shoe_threshold = s.threshold.threshold;
     c.zupt.shoe_threshold_auto = false;
     if (c.zupt.shoe_adaptive_factor <= 0.0) {
-      c.zupt.shoe_adaptive_factor = kAutoAdaptiveFactor;
-      c.zupt.shoe_adaptive_window_s = kAutoAdaptiveWindowS;
-      if (c.zupt.shoe_adaptive_min_peak_radps <= 0.0) c.zupt.shoe_adaptive_min_peak_radps = kAutoAdaptiveMinPeakRadps;
+      c.zupt.shoe_adaptive_factor = ins::kAutoAdaptiveFactor;
+      c.zupt.shoe_adaptive_window_s = ins::kAutoAdaptiveWindowS;
+      if (c.zupt.shoe_adaptive_min_peak_radps <= 0.0) {
+        c.zupt.shoe_adaptive_min_peak_radps = ins::kAutoAdaptiveMinPeakDegPerS * kDegToRad;
+      }
     }
     if (!c.zupt.edge_s_given) c.zupt.edge_s = kAutoEdgeS;
     if (!c.zupt.zaru_gate_given) c.zupt.zaru_gate_probability = kAutoZaruGateProbability;

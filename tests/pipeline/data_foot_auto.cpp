@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // The out-of-the-box configuration (datasets/foot/pyshoe_auto.yaml: `imu.spec: auto`, `zupt.shoe_threshold: auto`,
 // every other key default) on all 24 PyShoe Vicon trials, scored as scripts/pyshoe_cv does, and on the x-io loops.
-// The auto knobs (motion allowance 1.5, the ZARU gate and stance edges of `auto`) were chosen on the 4 `original`
-// trials only; the 20 `added` trials and the x-io loops are held out (docs/results.md "Out of the box").
+// The auto knobs were chosen on the 24 trials by leave-one-session-out cross-validation (the ZARU gate and stance
+// edges of `auto` on the 4 `original` trials); the x-io loops are held out (docs/results.md "Out of the box").
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,20 +21,23 @@ namespace {
 
 using namespace pednav::io;
 
-// Measured 2026-12-05 (Release; scripts/pyshoe_cv datasets/foot/pyshoe_auto.yaml): tuning median 0.90x PyShoe's
-// per-trial tuned error, worst 1.03x; held out median 1.39x, worst 30.4x (2018-02-09-11-22-01: stances of the first
-// slow shuffling steps missed, 2.02 m), pednav better than PyShoe with one threshold on 15 of 20, mean 0.231 m.
-// Bounds: measured + 5 % (deterministic runs; the margin is for another libm), counts exact. Issue 37's targets
-// (held-out median <= 1.0x, worst <= 2.0x, >= 90 % better than one threshold) are NOT met and not asserted.
-constexpr double kTuningMedianMax = 0.90 * 1.05;
-constexpr double kTuningWorstMax = 1.03 * 1.05;
-constexpr double kHeldOutMedianMax = 1.39 * 1.05;
-constexpr double kHeldOutWorstMax = 30.4 * 1.05;
-constexpr int kHeldOutBeatsOneThresholdMin = 15;
-// x-io loops with the same configuration (held out), measured 0.025 m / 0.192 m end-point error (the committed x-io
-// configuration, chosen on these loops: 0.023 / 0.122 m).
-constexpr double kXioShortClosureMax_m = 0.025 * 1.05;
-constexpr double kXioLongClosureMax_m = 0.192 * 1.05;
+// The auto knobs (motion allowance 2.5, adaptive factor 4, swing 360 °/s) were chosen by leave-one-session-out
+// cross-validation on all 24 trials (scripts/pyshoe_loso): every figure here is in-sample for that choice; the
+// cross-validated (out-of-fold) figures are in docs/results.md "Out of the box" (all 24: median 1.29x PyShoe's
+// per-trial tuned error, worst 3.21x). Measured 2026-12-05 (Release; scripts/pyshoe_cv datasets/foot/pyshoe_auto.yaml):
+// `original` trials median 0.98x, worst 1.09x, 4/4 better than PyShoe with one threshold; `added` trials median
+// 1.37x, worst 2.86x (2018-02-22-10-09-36), 16/20. Bounds: measured + 5 % (deterministic runs; the margin is for
+// another libm), counts exact. Issue 37's targets (median <= 1.0x, worst <= 2.0x, >= 90 % better than one threshold)
+// are NOT met and not asserted.
+constexpr double kOriginalMedianMax = 0.98 * 1.05;
+constexpr double kOriginalWorstMax = 1.09 * 1.05;
+constexpr double kAddedMedianMax = 1.37 * 1.05;
+constexpr double kAddedWorstMax = 2.86 * 1.05;
+constexpr int kAddedBeatsOneThresholdMin = 16;
+// x-io loops with the same configuration (held out: never used to choose an auto knob), measured 0.056 m / 0.152 m
+// end-point error (the committed x-io configuration, chosen on these loops: 0.023 / 0.122 m).
+constexpr double kXioShortClosureMax_m = 0.056 * 1.05;
+constexpr double kXioLongClosureMax_m = 0.152 * 1.05;
 
 struct Trial {
   std::string name, split;
@@ -126,23 +129,23 @@ GroupFigures figures(const std::vector<Trial>& t, bool tuning) {
   return g;
 }
 
-TEST(DataFootAuto, PyshoeTrialsTuningSubsetAndHeldOut) {
+TEST(DataFootAuto, PyshoeTrialsOriginalAndAdded) {
   PEDNAV_REQUIRE_DATA(test::shared_data("foot_pyshoe_vicon/trials.csv"));
   std::vector<Trial> trials = read_trials();
   ASSERT_EQ(trials.size(), 24u);
   for (auto& t : trials) t.pednav_m = run_trial(t.name);
-  const GroupFigures tune = figures(trials, true), held = figures(trials, false);
-  ASSERT_EQ(tune.trials, 4);
-  ASSERT_EQ(held.trials, 20);
-  std::printf("[pyshoe auto] tuning: median %.3fx, worst %.3fx, %d/4 better than one threshold; held out: median "
+  const GroupFigures orig = figures(trials, true), added = figures(trials, false);
+  ASSERT_EQ(orig.trials, 4);
+  ASSERT_EQ(added.trials, 20);
+  std::printf("[pyshoe auto] original: median %.3fx, worst %.3fx, %d/4 better than one threshold; added: median "
               "%.3fx, worst %.2fx, %d/20 better than one threshold\n",
-              tune.median, tune.worst, tune.beats, held.median, held.worst, held.beats);
-  EXPECT_LT(tune.median, kTuningMedianMax);
-  EXPECT_LT(tune.worst, kTuningWorstMax);
-  EXPECT_EQ(tune.beats, 4);
-  EXPECT_LT(held.median, kHeldOutMedianMax);
-  EXPECT_LT(held.worst, kHeldOutWorstMax);
-  EXPECT_GE(held.beats, kHeldOutBeatsOneThresholdMin);
+              orig.median, orig.worst, orig.beats, added.median, added.worst, added.beats);
+  EXPECT_LT(orig.median, kOriginalMedianMax);
+  EXPECT_LT(orig.worst, kOriginalWorstMax);
+  EXPECT_EQ(orig.beats, 4);
+  EXPECT_LT(added.median, kAddedMedianMax);
+  EXPECT_LT(added.worst, kAddedWorstMax);
+  EXPECT_GE(added.beats, kAddedBeatsOneThresholdMin);
 }
 
 TEST(DataFootAuto, XioLoopsWithTheSameConfiguration) {
