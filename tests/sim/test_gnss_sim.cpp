@@ -86,8 +86,16 @@ TEST(GnssSim, SdResidualsWithTruthHaveTheConfiguredSigmas) {
   const double ratio_code = std::sqrt(sc / res.size()), ratio_rate = std::sqrt(sr / res.size());
   std::printf("SD code residual std / configured %.3f, range rate %.3f (%zu residuals, mean sigma %.2f m)\n", ratio_code,
               ratio_rate, res.size(), atm_share / res.size());
-  EXPECT_NEAR(ratio_code, 1.0, kTolSigmaRatio);
+  EXPECT_NEAR(ratio_code, 1.0, kTolSigmaRatio);  // issue 4
   EXPECT_NEAR(ratio_rate, 1.0, kTolSigmaRatio);
+  // Measured 2026-12-05 (fixed seed, deterministic): 0.998 and 1.012 over 7467 residuals, mean σ 1.98 m. A sample σ
+  // ratio over N residuals spreads by ~1/√(2N) = 0.8 % for independent ones; the multipath (τ 20 s) correlates them,
+  // so a change of the random sequence (another draw order) may move it by a few %: ±3 % of 1 beside the issue's
+  // ±10 %. The residual count and the mean σ are functions of the scenario's geometry: ±1 %.
+  EXPECT_NEAR(ratio_code, 1.0, 0.03);
+  EXPECT_NEAR(ratio_rate, 1.0, 0.03);
+  EXPECT_NEAR(static_cast<double>(res.size()), 7467.0, 0.01 * 7467.0);
+  EXPECT_NEAR(atm_share / res.size(), 1.98, 0.01 * 1.98);
 }
 
 TEST(GnssSim, ResidualAtmosphereGrowsWithBaseline) {
