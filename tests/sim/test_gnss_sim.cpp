@@ -111,7 +111,8 @@ TEST(GnssSim, ResidualAtmosphereGrowsWithBaseline) {
     return std::sqrt(s / v.size());
   };
   const double rn = rms(sd_residuals(*sn)), rf = rms(sd_residuals(*sf));
-  EXPECT_GT(rf, 5.0 * rn);  // 600 ppm x 5 km = 3 m / sin(el) vs < 1 m of receiver noise
+  // 600 ppm x 5 km = 3 m / sin(el) vs < 1 m of receiver noise. Measured 2026-12-05: 10.02 m vs 1.79 m (5.6×).
+  EXPECT_GT(rf, 5.0 * rn);
 }
 
 TEST(GnssSim, BlundersAppearAtTheConfiguredRateAndAreRecorded) {
@@ -136,7 +137,7 @@ TEST(GnssSim, BlundersAppearAtTheConfiguredRateAndAreRecorded) {
     EXPECT_LT(std::abs(it->second->code_m - b.error_m), 6.0 * it->second->sigma_code_m);
     ++checked;
   }
-  EXPECT_GT(checked, 20);
+  EXPECT_GT(checked, 178 * 10 / 13);  // measured 2026-12-05: 178 blunders seen at the base (63 events)
 }
 
 // sim::receiver_weight_model: the filter's eq. W1–W2 weights that describe the simulated receiver (pednav montecarlo
