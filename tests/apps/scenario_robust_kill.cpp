@@ -135,10 +135,14 @@ TEST(RobustAtomicOutputs, KilledRunLeavesNoPartialFileUnderAFinalName) {
     with_outputs += status < 0 && finals > 0;
     with_temporaries += temporaries;
   }
-  std::printf("[ robust ] %d runs, %d killed by the signal: %d of them after the first output was complete (%d with "
-              "only part of the outputs), %d left a temporary file; run alone %.2f s, final delay scale %.2f\n",
-              attempts, killed, with_outputs, partial_sets, with_temporaries, run_s, delay_scale);
-  EXPECT_GE(killed, kKills / 2);
+  // The counts depend on the machine's load (when each signal lands), so they are not bounded beyond the kills the
+  // test needs; they are shown only when that check fails.
+  char what[256];
+  std::snprintf(what, sizeof what,
+                "%d runs, %d killed by the signal: %d of them after the first output was complete (%d with only part "
+                "of the outputs), %d left a temporary file; run alone %.2f s, final delay scale %.2f",
+                attempts, killed, with_outputs, partial_sets, with_temporaries, run_s, delay_scale);
+  EXPECT_GE(killed, kKills / 2) << what;
 }
 
 }  // namespace

@@ -61,6 +61,10 @@ std::vector<McRun> synthetic_runs(int runs, int epochs, double scale, uint32_t s
 }
 
 constexpr int kRuns = 200, kEpochs = 300;
+// Measured 2026-12-05 (seed 7, libstdc++'s normal_distribution): NEES in band 0.953, mean NEES 1.996, σ ratio
+// horizontal 1.003, yaw 0.994, inside 3σ 0.9949. These bounds stay the statistical ones, wider than the measured
+// figures: the test is of the statistics (any seed of a consistent filter must pass), and the epochs' figures are
+// correlated across the 300 epochs of a run, so their spread is larger than M·K = 60 000 independent draws suggest.
 constexpr double kMinInBand = 0.9;        // a consistent filter: ~95 % of epochs in the 95 % band [-]
 constexpr double kRatioTol = 0.05;        // σ ratio of a consistent filter within 5 % of 1 (M·K = 60 000 draws) [-]
 
@@ -186,6 +190,11 @@ TEST(Seed000ChannelFilter, SampleSigmaMatchesFilterSigma) {
   std::printf("[ seed 000 ] M = %d, K = %d: sqrt(P11) %.4f m/s at the end; worst sample/filter sigma ratio %.4f at "
               "step %d\n",
               kMcRuns, kSteps, std::sqrt(p11.back()), worst, worst_k);
+  // Measured 2026-12-05 (seed 2017, libstdc++): √P11 0.2161 m/s at the end (deterministic: the covariance recursion),
+  // worst |sample σ / filter σ − 1| 0.0486 over the 1200 steps (the largest of 1200 correlated estimates whose SE is
+  // 1.6 %: about 3 SE). Beside the 10 %: √P11 ±0.5 %, the worst deviation + 30 % (fixed seed).
+  EXPECT_NEAR(std::sqrt(p11.back()), 0.2161, 0.005 * 0.2161);
+  EXPECT_LT(std::abs(worst - 1.0), 1.3 * 0.0486);
   // The check can fail: a filter that under-reports its σ by 20 % is caught.
   const double mean = sum.back() / kMcRuns;
   const double sd = std::sqrt((sum2.back() - kMcRuns * mean * mean) / (kMcRuns - 1));

@@ -62,15 +62,18 @@ Final run_ins(const sim::Simulation& s, bool auto_scale_states) {
   return f;
 }
 
-// Measured when written (seeds 41-60, 270 m each, at the last epoch): auto (states on) mean final error 0.202 % of
-// the distance, RMS yaw error / RMS yaw σ 1.14; states off 0.698 %, 4.73 (100-seed Monte Carlo, median over the
-// epochs of sample σ / filter σ of yaw: 0.99 vs 3.30, docs/consistency.md §3.16).
+// Measured 2026-12-05 (Release; seeds 41-60, 270 m each, at the last epoch): auto (states on) mean final error
+// 0.202 % of the distance, RMS yaw error / RMS yaw σ 1.14; states off 0.698 %, 4.73 (100-seed Monte Carlo, median
+// over the epochs of sample σ / filter σ of yaw: 0.99 vs 3.30, docs/consistency.md §3.16). Bounds: the figures with
+// the states +25 % (an average of 20 deterministic runs; the margin covers another compiler or libm), the figures
+// without them / 1.3 (the defect the states fix must stay visible). The yaw ratio's lower bound 0.8 is the
+// consistency requirement (σ at most 25 % pessimistic), not a measured figure.
 constexpr int kSeeds = 20;
 constexpr double kDistanceM = 270.0;
-constexpr double kMaxMeanPctWith = 0.35;
-constexpr double kMinMeanPctWithout = 0.45;
-constexpr double kYawRatioLo = 0.6, kYawRatioHi = 1.6;
-constexpr double kMinYawRatioWithout = 2.0;
+constexpr double kMaxMeanPctWith = 0.202 * 1.25;
+constexpr double kMinMeanPctWithout = 0.698 / 1.3;
+constexpr double kYawRatioLo = 0.8, kYawRatioHi = 1.14 * 1.25;
+constexpr double kMinYawRatioWithout = 4.73 / 1.3;
 
 TEST(InsScaleStates, UncalibratedGyroGetsScaleStatesAndAnHonestYawSigma) {
   auto file = io::load_scenario("datasets/indoor_loops.yaml");

@@ -38,9 +38,12 @@ output: {truth_rate_hz: 1}
 )";
 
 constexpr double kOffset_m = 0.5;
-// Mean smoothed north error over the static start [m]. Measured when written: without the arm +0.41, with it −0.06.
-constexpr double kMinBiasWithout = 0.3;
-constexpr double kMaxBiasWith = 0.12;
+// Mean smoothed north error over the static start [m]. Measured 2026-12-05 (Release, seed 31, 56 epochs): without the
+// arm +0.445, with it −0.036. Bounds: with the arm |bias| < 0.05 m (measured + 40 %: a mean of 56 smoothed epochs of
+// one deterministic run; 0.05 m is 10 % of the 0.5 m offset); without it > 0.35 m (measured / 1.27: the offset
+// must still show).
+constexpr double kMinBiasWithout = 0.35;
+constexpr double kMaxBiasWith = 0.05;
 
 TEST(HeadingLeverArm, SmoothedStaticStartHasNoCrossTrackBiasOnlyWithTheArm) {
   const io::ScenarioFile file = test::scenario_from_text(kOffsetWalk);
@@ -69,7 +72,7 @@ TEST(HeadingLeverArm, SmoothedStaticStartHasNoCrossTrackBiasOnlyWithTheArm) {
       sum_n += d_n.x();
       ++n;
     }
-    ASSERT_GT(n, 40);
+    ASSERT_EQ(n, 56);  // smoothed epochs in the first 55 s (measured 2026-12-05)
     bias[on] = sum_n / n;
     std::printf("[ lever arm ] heading arm %s: smoothed mean north error over the static start %+.3f m (%d epochs)\n",
                 on ? "on" : "off", bias[on], n);

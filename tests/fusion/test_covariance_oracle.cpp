@@ -15,6 +15,7 @@
 // The form D / form F yaw test on the engine (eq. 19 vs eq. 24) is tests/fusion/test_zupt_consistency.cpp.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -146,8 +147,14 @@ Closed continuous(const Setting& s, double g) {
   return {p, p + w2 * T, g * g * T * T * p + f2 * T + g * g * w2 * T * T * T / 3.0, g * T * (p + 0.5 * w2 * T)};
 }
 
-void expect_match(const Result& r, const Closed& c, double tol, const char* what) {
+// Checks each stationary covariance against the closed form within tol; returns the largest |ratio − 1|.
+double expect_match(const Result& r, const Closed& c, double tol, const char* what) {
+  double worst = 0.0;
   for (int i = 0; i < 2; ++i) {
+    for (const double ratio : {r.P_beta_post[i] / c.P_beta, r.P_beta_prior[i] / c.P_beta_prior,
+                               r.P_dv_prior[i] / c.P_dv_prior, r.P_dvbeta_prior[i] / c.P_dvbeta_prior}) {
+      worst = std::max(worst, std::abs(ratio - 1.0));
+    }
     std::printf("[ %s ] channel %c: P_beta %.4g vs %.4g, P_beta- %.4g vs %.4g, P_dv- %.4g vs %.4g, P_dvbeta- %.4g vs "
                 "%.4g\n",
                 what, i == 0 ? 'N' : 'E', r.P_beta_post[i], c.P_beta, r.P_beta_prior[i], c.P_beta_prior,
@@ -157,7 +164,21 @@ void expect_match(const Result& r, const Closed& c, double tol, const char* what
     EXPECT_NEAR(r.P_dv_prior[i] / c.P_dv_prior, 1.0, tol) << what << " eq. 17 P_dv-, channel " << i;
     EXPECT_NEAR(r.P_dvbeta_prior[i] / c.P_dvbeta_prior, 1.0, tol) << what << " eq. 17 P_dvbeta-, channel " << i;
   }
+  std::printf("[ %s ] largest |ratio - 1| %.3e\n", what, worst);
+  return worst;
 }
+
+// Measured 2026-12-05 (Release): the largest |ratio − 1| of the eight comparisons is 2.458e-2 at κ = 20 (the model
+// difference between noise added once per step and integrated over it) and 2.374e-4 for the continuous-noise fixed
+// point at the MEMS setting; the yaw growth of eq. 19 is within 1.13e-4 (κ = 20) and 2.07e-4 (MEMS) of σ_ω² T. The
+// recursion is deterministic: each bound is the measured deviation + 50 % (round-off and the Earth-rate terms may
+// move the smallest ones by a few 1e-5), beside the tolerance (5 % / 2 %), so a change of the error model
+// that stays inside the tolerance still shows.
+constexpr double kPaperDevMax = 2.458e-2 * 1.5;
+constexpr double kContinuousDevMax = 2.374e-4 * 1.5;
+constexpr double kEq19DevMax = 2.07e-4 * 1.5;
+// Eq. 16 (noise once per step) against the filter's P_β at the MEMS setting, measured 2026-12-05: 3.33×; ±5 %.
+constexpr double kMemsPaperOverFilter = 3.33;
 
 // κ = 20: accelerometer noise dominates; eqs. 16-17 and the continuous fixed point agree to ~2.5 %.
 constexpr Setting kPaperRegime{1e-4, 20.0 * 1e-4 * 9.81 * 1.0, 1.0};
@@ -166,29 +187,30 @@ constexpr Setting kMemsRegime{0.1 * kDegToRad, 200e-6 * 9.80665, 1.25};
 
 TEST(Seed001Oracle, StationaryCovariancesMatchEq16And17) {
   const Result r = run_recursion(kPaperRegime, fusion::ZuptForm::kDynamic);
-  expect_match(r, paper(kPaperRegime, r.g), kPaperTol, "eq. 16-17, kappa 20");
+  EXPECT_LT(expect_match(r, paper(kPaperRegime, r.g), kPaperTol, "eq. 16-17, kappa 20"), kPaperDevMax);
 }
 
 TEST(Seed001Oracle, YawIsARandomWalkEq19) {
   for (const Setting& s : {kPaperRegime, kMemsRegime}) {
     const Result r = run_recursion(s, fusion::ZuptForm::kDynamic);
     const double q = s.sigma_w * s.sigma_w * s.T;  // σ_ω² T [rad²]
-    std::printf("[ eq. 19 ] yaw variance growth %.5g rad^2 per step vs sigma_w^2 T %.5g (ratio %.4f)\n",
+    std::printf("[ eq. 19 ] yaw variance growth %.5g rad^2 per step vs sigma_w^2 T %.5g (ratio %.6f)\n",
                 r.yaw_growth_per_step, q, r.yaw_growth_per_step / q);
     EXPECT_NEAR(r.yaw_growth_per_step / q, 1.0, kPaperTol);
+    EXPECT_NEAR(r.yaw_growth_per_step / q, 1.0, kEq19DevMax);
   }
 }
 
 TEST(Seed001Oracle, MemsRegimeMatchesTheContinuousNoiseFixedPoint) {
   const Result r = run_recursion(kMemsRegime, fusion::ZuptForm::kDynamic);
   const Closed c = continuous(kMemsRegime, r.g);
-  expect_match(r, c, kContinuousTol, "continuous, MEMS");
+  EXPECT_LT(expect_match(r, c, kContinuousTol, "continuous, MEMS"), kContinuousDevMax);
   // Seed 001's eq. 16 (noise added once per step) is far from the filter here: documented, not hidden.
   const Closed p = paper(kMemsRegime, r.g);
-  std::printf("[ MEMS ] kappa %.3f: eq. 16 P_beta %.4g = %.2f x the filter's %.4g\n",
-              kMemsRegime.sigma_f / (kMemsRegime.sigma_w * r.g * kMemsRegime.T), p.P_beta,
-              p.P_beta / r.P_beta_post[0], r.P_beta_post[0]);
-  EXPECT_GT(p.P_beta / r.P_beta_post[0], 2.0);
+  std::printf("[ MEMS ] eq. 16 P_beta %.4g = %.2f x the filter's %.4g\n", p.P_beta, p.P_beta / r.P_beta_post[0],
+              r.P_beta_post[0]);
+  EXPECT_GT(p.P_beta / r.P_beta_post[0], 2.0);  // the documented gap (file comment: ~3x at kappa ~0.1)
+  EXPECT_NEAR(p.P_beta / r.P_beta_post[0], kMemsPaperOverFilter, 0.05 * kMemsPaperOverFilter);
 }
 
 }  // namespace

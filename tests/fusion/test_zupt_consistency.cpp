@@ -62,10 +62,14 @@ ins::ImuSpec white_noise_spec() {
 
 // Issue 5 asks for ±25 %; in the linear model eq. 19 is exact for form D (yaw is driven by gyro noise only), so
 // the covariance (deterministic) is held to ±5 %: ±25 % would also accept form F's 0.83 on this 4-min walk,
-// i.e. would not fail when the forms are swapped. Measured: D with the linearization reset of docs/fusion.md §5.1
-// 0.998, form F 0.828 (falling further on longer walks: seed 001 eq. 24).
+// i.e. would not fail when the forms are swapped. Measured 2026-12-05 (Release): D with the linearization reset of
+// docs/fusion.md §5.1 0.99869 (|ratio − 1| 1.310e-3), form F 0.832 (falling further on longer walks: seed 001 eq. 24). Beside the
+// ±5 % of eq. 19, form D's measured deviation from 1 is bounded at +50 % (a covariance, deterministic), and form F's
+// ratio at 0.832 ± 5 % of it.
 constexpr double kRandomWalkTolerance = 0.05;  // form D: growth rate within ±5 % of σ_ω²
+constexpr double kFormDDevMax = 1.310e-3 * 1.5;  // form D: measured |ratio − 1| + 50 %
 constexpr double kBoundedRatio = 0.9;          // form F: growth rate below 0.9 σ_ω² (heading falsely observed)
+constexpr double kFormFRatio = 0.832;           // form F: measured growth rate / σ_ω²
 constexpr double kInitialYawSigmaRad = 1.0 * kDegToRad;
 
 struct YawGrowth {
@@ -131,7 +135,9 @@ TEST_F(ZuptConsistency, FormDYawVarianceGrowsAsARandomWalk) {
   std::printf("[ form D ] yaw variance %.4g -> %.4g rad^2 over %.0f s: growth %.4g rad^2/s = %.3f x sigma_w^2 "
               "(sigma_w^2 T per 1.2 s step: %.4g rad^2)\n",
               g.p_start_rad2, g.p_end_rad2, g.duration_s, g.rate_rad2_per_s(), ratio, q * 1.2);
+  std::printf("[ form D ] |ratio - 1| %.3e\n", std::abs(ratio - 1.0));
   EXPECT_NEAR(ratio, 1.0, kRandomWalkTolerance) << "seed 001 eq. 19: P_yaw grows by sigma_w^2 T per step";
+  EXPECT_NEAR(ratio, 1.0, kFormDDevMax) << "measured deviation from eq. 19";
   // A random walk never shrinks: the yaw variance at the end is the largest.
   EXPECT_NEAR(g.max_p_rad2, g.p_end_rad2, 1e-3 * g.p_end_rad2);
 }
@@ -144,16 +150,22 @@ TEST_F(ZuptConsistency, FormFYawVarianceIsFalselyBounded) {
               "sigma_w^2\n",
               g.p_start_rad2, g.p_end_rad2, g.max_p_rad2, g.duration_s, g.rate_rad2_per_s(), ratio);
   EXPECT_LT(ratio, kBoundedRatio) << "seed 001 eq. 24: with form F the heading looks observable";
+  EXPECT_NEAR(ratio, kFormFRatio, 0.05 * kFormFRatio);
 }
 
 // docs/fusion.md §5.5: in ins mode the initial heading σ is carried outside the filter as a rotation about the start.
 // In the linear model form D cannot observe that rotation, so the split must not change the reported σ: the frame
 // term added to the output replaces the yaw variance removed from P. The trajectories differ only through
-// second-order effects (stance edges where the detected ZUPT is not exact): measured max 0.85 m, horizontal RMS
-// error vs truth 1.02 m (split) vs 0.80 m (whole), end error 0.989 vs 0.985 m on this walk.
+// second-order effects (stance edges where the detected ZUPT is not exact). Measured 2026-12-05 (Release): max
+// difference 0.856 m, horizontal RMS error vs truth 1.024 m (split) vs 0.804 m (whole), end error 0.987 vs 0.983 m,
+// largest horizontal σ 10.93 m, final σ_yaw 10.12° / 10.08°. Errors bounded at the measured figure + 30 % (a 4-min
+// filter run: the margin covers the -O1/-O2 sanitizer builds), σ within ±10 % (a covariance: deterministic).
 constexpr double kFrameYawSigmaRad = 10.0 * kDegToRad;  // the run configurations' default initial σ_yaw
-constexpr double kSplitTrajectoryTol_m = 1.5;           // max horizontal difference of the two runs (measured 0.85)
+constexpr double kSplitTrajectoryTol_m = 0.856 * 1.3;   // max horizontal difference of the two runs
 constexpr double kSplitSigmaTolRel = 0.05;              // reported horizontal / yaw σ agree within 5 %
+constexpr double kRmsSplitMax_m = 1.024 * 1.3, kRmsWholeMax_m = 0.804 * 1.3;
+constexpr double kEndSplitMax_m = 0.987 * 1.3, kEndWholeMax_m = 0.983 * 1.3;
+constexpr double kMaxSdH_m = 10.93, kEndSdYawSplit_deg = 10.12, kSigmaTol = 0.10;
 
 TEST_F(ZuptConsistency, HeadingFrameSplitIsEquivalentWhenZuptsAreExact) {
   auto run_split = [&](bool as_frame) {
@@ -186,10 +198,16 @@ TEST_F(ZuptConsistency, HeadingFrameSplitIsEquivalentWhenZuptsAreExact) {
     rms_split += std::pow(truth_error_m(split.epochs[k]), 2);
     rms_whole += std::pow(truth_error_m(whole.epochs[k]), 2);
   }
-  std::printf("[frame split] horizontal RMS error vs truth: split %.3f m, whole %.3f m; end %.3f / %.3f m\n",
-              std::sqrt(rms_split / split.epochs.size()), std::sqrt(rms_whole / whole.epochs.size()),
-              truth_error_m(split.epochs.back()), truth_error_m(whole.epochs.back()));
   ASSERT_EQ(split.epochs.size(), whole.epochs.size());
+  rms_split = std::sqrt(rms_split / split.epochs.size());
+  rms_whole = std::sqrt(rms_whole / whole.epochs.size());
+  const double end_split = truth_error_m(split.epochs.back()), end_whole = truth_error_m(whole.epochs.back());
+  std::printf("[frame split] horizontal RMS error vs truth: split %.3f m, whole %.3f m; end %.3f / %.3f m\n",
+              rms_split, rms_whole, end_split, end_whole);
+  EXPECT_LT(rms_split, kRmsSplitMax_m);
+  EXPECT_LT(rms_whole, kRmsWholeMax_m);
+  EXPECT_LT(end_split, kEndSplitMax_m);
+  EXPECT_LT(end_whole, kEndWholeMax_m);
   ASSERT_GT(split.epochs.size(), 100u);
   double max_diff_m = 0, max_sd_h_m = 0;
   for (size_t k = 0; k < split.epochs.size(); ++k) {
@@ -210,7 +228,8 @@ TEST_F(ZuptConsistency, HeadingFrameSplitIsEquivalentWhenZuptsAreExact) {
               max_diff_m, max_sd_h_m, split.epochs.back().sd_yaw_rad / kDegToRad,
               whole.epochs.back().sd_yaw_rad / kDegToRad);
   EXPECT_LT(max_diff_m, kSplitTrajectoryTol_m);
-  EXPECT_GT(max_sd_h_m, 3.0);  // 10° over tens of metres: the frame term is really there
+  EXPECT_NEAR(max_sd_h_m, kMaxSdH_m, kSigmaTol * kMaxSdH_m);  // 10° over tens of metres: the frame term is there
+  EXPECT_NEAR(split.epochs.back().sd_yaw_rad / kDegToRad, kEndSdYawSplit_deg, kSigmaTol * kEndSdYawSplit_deg);
 }
 
 }  // namespace

@@ -130,7 +130,8 @@ TEST(Hmm, BaumWelchLikelihoodNeverDecreases) {
 
 // Synthetic sequences drawn from seed 002's trained model (Table 2) -> Baum-Welch from seed 002's initial model
 // (A1, Table 1) recovers the generator. 20 sequences of 2000 symbols: the sampling error of an entry p estimated
-// from ~10^4 visits of a state is sqrt(p(1-p)/10^4) <= 0.005; the tolerance is 4 times that.
+// from ~10^4 visits of a state is sqrt(p(1-p)/10^4) <= 0.005; the tolerance is 4 times that (a statistical bound,
+// kept: any seed must pass). Measured 2026-12-05 (seeds 7-26): max |error| 0.0028 in A, 0.0109 in B.
 TEST(Hmm, BaumWelchRecoversTheGenerator) {
   const HmmModel gen = seed002_trained_model();
   std::vector<std::vector<int>> seqs;
@@ -161,8 +162,10 @@ TEST(Hmm, DecodersFollowTheCycle) {
     ok_v += v[t] == d.states[t];
     ok_f += f[t] == d.states[t];
   }
-  // Table 2's emissions overlap only on grades 3 and 6 (A and C): both decoders get > 95 % of the states.
-  constexpr double kMinAccuracy = 0.95;
+  // Table 2's emissions overlap only on grades 3 and 6 (A and C): both decoders get nearly every state. Measured
+  // 2026-12-05 (seed 42): Viterbi 2999, forward 3000 of 3000; bound 99 % (30 misses: a few overlapping emissions more
+  // on another draw).
+  constexpr double kMinAccuracy = 0.99;
   EXPECT_GT(ok_v, kMinAccuracy * static_cast<double>(v.size()));
   EXPECT_GT(ok_f, kMinAccuracy * static_cast<double>(f.size()));
 }

@@ -49,8 +49,9 @@ TEST_P(EveryDetector, StillIsStanceMovingIsNot) {
   int moving_stance = 0;
   for (int k = 220; k < 380; ++k) moving_stance += d[k].stance;
   if (std::string(GetParam()) == "mag") {
-    // MAG only sees |f|: it is fooled whenever |f| passes through g while moving; most samples still rejected.
-    EXPECT_LT(moving_stance, 80);
+    // MAG only sees |f|: it can be fooled where |f| passes through g while moving. On this motion it is not
+    // (measured 2026-12-05: 0 of 160 moving samples); 5 samples (25 ms) of slack for a sample at the threshold.
+    EXPECT_LE(moving_stance, 5);
   } else {
     EXPECT_EQ(moving_stance, 0) << GetParam();
   }
@@ -151,7 +152,8 @@ TEST(ZuptDetector, HmmFindsEveryStanceOfASyntheticWalk) {
   EXPECT_EQ(runs, g.stances);
   // Stance = the smoothed rate within the two zero grades (|rate| < 1.05 rad/s) around a D observation: it
   // takes in < 0.02 s of each neighbouring half sine's flank (fp) and loses the smoothing edge (fn).
-  constexpr double kMinRecall = 0.85, kMinPrecision = 0.95;
+  // Measured 2026-12-05: 1170 true, 36 false stance samples (3 per stance), 0 missed: precision 0.970, recall 1.
+  constexpr double kMinRecall = 0.99, kMinPrecision = 0.95;
   EXPECT_GT(tp, kMinPrecision * (tp + fp));
   EXPECT_GT(tp, kMinRecall * (tp + fn));
   // Trained on the log: cyclic A -> B -> C -> D -> A dominates every row.
@@ -225,14 +227,16 @@ TEST(ZuptDetector, HmmRefineKeepsTheQuietCoreOfEachStance) {
   o.detector = "hmm";
   const StanceCount whole = count(g, detect_stance(g.samples, o));
   // Without refinement the decoded stance takes in the heel and toe rolls (|rate| < one grade, 1.05 rad/s).
-  constexpr int kMinRollingSamples = 12 * 20;  // at least 0.1 s of roll per step
+  // Measured 2026-12-05: 582 roll samples (48 per step); bound measured / 1.3.
+  constexpr int kMinRollingSamples = 582 * 10 / 13;
   EXPECT_GT(whole.rolling, kMinRollingSamples);
   o.hmm_refine_factor = 2.0;
   const StanceCount core = count(g, detect_stance(g.samples, o));
   EXPECT_EQ(core.runs, g.stances);  // still one stance per step
-  // The core is the flat foot (SHOE T < γ = 10 with σω 0.1 rad/s: |rate| < 0.32 rad/s) and a few roll samples
-  // where the 0.03 s SHOE window still averages in the flat part.
-  constexpr int kMaxRollingPerStep = 8;
+  // The core is the flat foot (SHOE T < γ = 10 with σω 0.1 rad/s: |rate| < 0.32 rad/s); a roll sample where the
+  // 0.03 s SHOE window still averages in the flat part may join it. Measured 2026-12-05: 0 roll samples, 60 flat-foot
+  // samples missed (5 per step); bounds 1 roll sample per step, the flat-foot one from its derivation below.
+  constexpr int kMaxRollingPerStep = 1;
   EXPECT_LE(core.rolling, kMaxRollingPerStep * g.stances);
   // It loses at most the SHOE half window (3 samples) plus one at each end of the flat foot.
   constexpr int kMaxFlatMissedPerStep = 8;
@@ -250,14 +254,14 @@ TEST(ZuptDetector, HmmRefineThresholdAdaptsToAFootThatNeverStops) {
   o.hmm_refine_factor = 2.0;
   const StanceCount c = count(g, detect_stance(g.samples, o));
   EXPECT_EQ(c.runs, g.stances);
-  EXPECT_LE(c.rolling, 8 * g.stances);
+  EXPECT_LE(c.rolling, g.stances);  // measured 2026-12-05: 0 roll samples (as for the adaptive SHOE below)
   // The gait-adaptive SHOE (threshold max(γ, 2 × the minimum of T within ±0.5 s)) finds them without the HMM.
   o.detector = "shoe";
   o.shoe_adaptive_factor = 2.0;
   o.shoe_adaptive_window_s = 1.0;
   const StanceCount a = count(g, detect_stance(g.samples, o));
   EXPECT_EQ(a.runs, g.stances);
-  EXPECT_LE(a.rolling, 8 * g.stances);
+  EXPECT_LE(a.rolling, g.stances);
 }
 
 // shoe_adaptive_min_peak_radps: the gait-adaptive threshold is raised only where a swing is near. A slow pivot (0.5

@@ -97,8 +97,13 @@ TEST(RobustRinexTruncation, CutRoverObsGivesAPrefixWithTruncationReportedOrAClea
       }
     }
   }
-  EXPECT_GT(ok, kReadOffsets / 2);
-  EXPECT_GT(dropped, 0);  // some cuts end inside the last satellite line of a record
+  // Measured 2026-12-05 over the 89 cuts (60 random + 29 at the file's end): 86 read, 13 of them with the cut last
+  // epoch dropped, 3 clear errors (cuts inside the header's continuation). The cuts and the file are deterministic
+  // (fixed seed, simulated file); the bounds allow a few cuts to move between the outcomes (another standard
+  // library's uniform_int_distribution gives other cut positions): read ≥ 90 % of measured, dropped within ±30 %.
+  EXPECT_GE(ok, 86 * 9 / 10);
+  EXPECT_NEAR(dropped, 13, 4);  // some cuts end inside the last satellite line of a record
+  EXPECT_LE(failed, 3 + 6);
   std::printf("[ robust ] rover.obs cut at %d offsets: %d read (%d with the cut last epoch dropped), %d errors\n",
               ok + failed, ok, dropped, failed);
 }
@@ -127,7 +132,11 @@ TEST(RobustImuTruncation, CutSimulatedImuLogGivesAPrefixOrAClearError) {
     }
     EXPECT_EQ(r->report.truncated_rows, text[cut - 1] != '\n' ? 1 : 0) << "cut at " << cut;
   }
+  std::printf("[ robust ] imu.csv cut at %d offsets: %d read, %d errors\n", ok + failed, ok, failed);
   EXPECT_GT(ok, kReadOffsets / 2);
+  // Measured 2026-12-05: all 89 cuts read (a cut IMU log is a prefix); two may move to a clear error (cuts that
+  // leave too few samples, another standard library's cut positions).
+  EXPECT_GE(ok, 89 - 2);
 }
 
 // Whole runs on cut files: completes (truncation in summary.json, finite solution) or fails naming the file.

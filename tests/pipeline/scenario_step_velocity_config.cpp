@@ -64,6 +64,7 @@ TEST(StepVelocityConfig, StepVelocityAloneKeepsAnInsWithoutZuptUpdatesTogether) 
               ev->horizontal_rms_m, ev->closure_pct_of_distance, ev->distance_m, sum->step_velocity_updates);
   EXPECT_LT(ev->horizontal_rms_m, kStepOnlyRmsMax_m);
   EXPECT_LT(ev->closure_pct_of_distance, kStepOnlyClosurePctMax);
+  EXPECT_NEAR(ev->distance_m, 235.0, 0.2 * 235.0);  // the solution's path (the walk is 270 m): ±20 %
 }
 
 }  // namespace

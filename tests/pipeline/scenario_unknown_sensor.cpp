@@ -30,8 +30,16 @@ namespace {
 // deterministic; the margin is for another libm), which the non-auto configuration does not meet.
 constexpr double kMaxClosurePct = 1.0;
 constexpr double kMaxRms_m = 0.55;
-// Calibration (measured: ARW 18.3 / 18.0 / 17.6 deg/sqrt(h) against the simulated 18; +z up, 30.2° tilt).
+constexpr double kMeasuredClosurePct = 0.31, kMeasuredDistance_m = 187.9;  // closure bound + 30 %, distance ±1 %
+// Calibration, measured 2026-12-05: ARW 18.30 / 18.02 / 17.61 deg/√h against the simulated 18, VRW 0.3537 / 0.3521 /
+// 0.3531 m/s/√h against 0.353; +z up, tilt 30.204°. Beside the issue's ±20 %: each axis within ±3 % of its measured
+// figure (an estimate from one seeded log: deterministic; 3 % lets the still-period windows move by one), the
+// tilt within ±0.1°.
 constexpr double kNoiseTolerance = 0.2;  // issue 37: noise density within 20 %
+constexpr double kArwMeasured_deg_per_sqrt_h[3] = {18.30, 18.02, 17.61};
+constexpr double kVrwMeasured_mps_per_sqrt_h[3] = {0.3537, 0.3521, 0.3531};
+constexpr double kMeasuredNoiseTolerance = 0.03;
+constexpr double kTiltMeasured_deg = 30.204;
 
 TEST(UnknownSensor, CalibrateRecoversTheSensorAndAutoClosesTheLoop) {
   auto file = io::load_scenario(test::source_path("datasets/unknown_sensor.yaml"));
@@ -62,8 +70,16 @@ TEST(UnknownSensor, CalibrateRecoversTheSensorAndAutoClosesTheLoop) {
   for (int i = 0; i < 3; ++i) {
     EXPECT_NEAR(c.gyro_noise_density(i), arw_true, kNoiseTolerance * arw_true) << "axis " << i;
     EXPECT_NEAR(c.accel_noise_density(i), vrw_true, kNoiseTolerance * vrw_true) << "axis " << i;
+    const double arw = c.gyro_noise_density(i) * kRadToDeg * 60.0, vrw = c.accel_noise_density(i) * 60.0;
+    EXPECT_NEAR(arw, kArwMeasured_deg_per_sqrt_h[i], kMeasuredNoiseTolerance * kArwMeasured_deg_per_sqrt_h[i]) << i;
+    EXPECT_NEAR(vrw, kVrwMeasured_mps_per_sqrt_h[i], kMeasuredNoiseTolerance * kVrwMeasured_mps_per_sqrt_h[i]) << i;
   }
+  EXPECT_NEAR(c.tilt_deg, kTiltMeasured_deg, 0.1);
 
+  std::printf("[unknown sensor, calibrate] tilt %.3f deg; ARW %.2f %.2f %.2f deg/sqrt(h); VRW %.4f %.4f %.4f m/s/sqrt(h)\n",
+              c.tilt_deg, c.gyro_noise_density(0) * kRadToDeg * 60.0, c.gyro_noise_density(1) * kRadToDeg * 60.0,
+              c.gyro_noise_density(2) * kRadToDeg * 60.0, c.accel_noise_density(0) * 60.0,
+              c.accel_noise_density(1) * 60.0, c.accel_noise_density(2) * 60.0);
   cfg->imu.spec_auto = true;
   cfg->zupt.shoe_threshold_auto = true;
   auto sum = pipeline::run_run_command(*cfg, dir + "/run");
@@ -78,7 +94,9 @@ TEST(UnknownSensor, CalibrateRecoversTheSensorAndAutoClosesTheLoop) {
   ASSERT_TRUE(ev) << ev.error().message;
   std::printf("[unknown sensor, auto] closure %.3f m = %.2f %% of %.1f m, RMS %.3f m\n", ev->closure_m,
               ev->closure_pct_of_distance, ev->distance_m, ev->horizontal_rms_m);
-  EXPECT_LT(ev->closure_pct_of_distance, kMaxClosurePct);
+  EXPECT_LT(ev->closure_pct_of_distance, kMaxClosurePct);  // issue 37
+  EXPECT_LT(ev->closure_pct_of_distance, 1.3 * kMeasuredClosurePct);
+  EXPECT_NEAR(ev->distance_m, kMeasuredDistance_m, 0.01 * kMeasuredDistance_m);
   EXPECT_LT(ev->horizontal_rms_m, kMaxRms_m);
 }
 

@@ -94,11 +94,19 @@ TEST(SlowRobustTruncation, RoverObsCutAtEveryLineEndAndMidLineGivesAPrefixOrACle
           << "cut at " << cut;
     }
   }
-  std::printf("[ robust ] rover.obs (%zu bytes) cut at %zu offsets (%d mid-line): %d read (%d with the cut last epoch "
-              "dropped), %d errors\n",
-              text.size(), cuts.size(), mid_line, ok, dropped, failed);
+  std::printf("[ robust ] rover.obs cut at %zu offsets (%d mid-line): %d read (%d with the cut last epoch dropped), "
+              "%d errors\n",
+              cuts.size(), mid_line, ok, dropped, failed);
+  // Measured 2026-12-05 (cuts at every line end and mid-line of a simulated file: deterministic): 2616 cuts, 1296
+  // mid-line, 2593 read (99.1 %), 108 with the cut last epoch dropped (4.1 %), 23 clear errors (cuts inside the
+  // header's last records). Bounds as fractions of the cuts, so that a change of the simulated file's length does
+  // not matter: read ≥ 98 %, dropped 3-5 %, about half of the cuts mid-line.
+  const double n = static_cast<double>(cuts.size());
   EXPECT_GT(dropped, 0);
-  EXPECT_GT(ok, static_cast<int>(cuts.size()) / 2);
+  EXPECT_GE(ok, 0.98 * n);
+  EXPECT_GE(dropped, 0.03 * n);
+  EXPECT_LE(dropped, 0.05 * n);
+  EXPECT_NEAR(mid_line, 0.5 * n, 0.02 * n);
 }
 
 TEST(SlowRobustTruncation, ImuLogCutAtManyLineEndsAndMidLinesGivesAPrefixOrAClearError) {
@@ -128,9 +136,9 @@ TEST(SlowRobustTruncation, ImuLogCutAtManyLineEndsAndMidLinesGivesAPrefixOrAClea
       ASSERT_EQ(r->samples[i].f_ib_b, full->samples[i].f_ib_b) << "cut at " << cut;
     }
   }
-  std::printf("[ robust ] imu.csv (%zu bytes) cut at %zu offsets: %d read, %d errors\n", text.size(), cuts.size(), ok,
-              failed);
-  EXPECT_GT(ok, static_cast<int>(cuts.size()) / 2);
+  std::printf("[ robust ] imu.csv cut at %zu offsets: %d read, %d errors\n", cuts.size(), ok, failed);
+  // Measured 2026-12-05: 1088 cuts, 1086 read (99.8 %), 2 clear errors (cuts that leave too few samples): read ≥ 99 %.
+  EXPECT_GE(ok, 0.99 * static_cast<double>(cuts.size()));
 }
 
 }  // namespace

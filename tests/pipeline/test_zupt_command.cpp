@@ -64,8 +64,10 @@ TEST(ZuptCommand, DetectorScoredAgainstTheLogsStanceLabels) {
   auto shoe = run(dir, labelled, "shoe", true);
   ASSERT_TRUE(shoe) << shoe.error().message;
   EXPECT_EQ(shoe->label_stance_samples, 400);
+  // Measured 2026-12-05: precision 1.0000, recall 0.9850 (the window edges of each stance). Bounds: the recall's
+  // miss rate × 2; the precision keeps 0.97 (an edge sample at the threshold may flip on another compiler).
   EXPECT_GT(shoe->label_precision, 0.97);  // window edges may flag a few moving samples
-  EXPECT_GT(shoe->label_recall, 0.9);
+  EXPECT_GT(shoe->label_recall, 0.97);
   std::ifstream js(dir / "out_shoe" / "summary.json");
   std::stringstream ss;
   ss << js.rdbuf();
@@ -77,8 +79,8 @@ TEST(ZuptCommand, DetectorScoredAgainstTheLogsStanceLabels) {
   auto wrong = run(dir, inverted, "shoe", true);
   ASSERT_TRUE(wrong) << wrong.error().message;
   EXPECT_EQ(wrong->label_stance_samples, 200);
-  EXPECT_LT(wrong->label_precision, 0.05);
-  EXPECT_LT(wrong->label_recall, 0.05);
+  EXPECT_LT(wrong->label_precision, 0.01);  // measured 2026-12-05: 0 and 0
+  EXPECT_LT(wrong->label_recall, 0.01);
 
   // Detector `labels` agrees with itself; without a label column no score, and `labels` is refused.
   auto self = run(dir, labelled, "labels", true);

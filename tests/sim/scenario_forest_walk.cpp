@@ -22,6 +22,14 @@ namespace {
 constexpr double kSeed004Rms_m = 5.3, kRmsTolFraction = 0.25;     // seed 004 Table 1, issue 4 tolerance
 constexpr double kSeed004Lt5_pct = 74.1, kLt5Tol_pct = 10.0;
 constexpr double kMaxGenerate_s = 15.0;  // issue target 5 s on an idle machine; loose here (shared CI cores)
+// Measured 2026-12-05 (Release; the simulation and `pednav gnss` are deterministic): horizontal RMS 5.31 m, epochs
+// under 5 m / 5-10 / 10-20 / >= 20 m 70.5 / 24.3 / 4.6 / 0.6 %, 1081 epochs compared. Bounds beside seed 004's
+// targets: RMS +10 % / −10 %, the bins ±3 / ±3 / ±2 / ±1 percentage points (one epoch is 0.09 point); the epoch count
+// exact (1 Hz over the 18-min scenario).
+constexpr double kMeasuredRms_m = 5.31, kMeasuredRmsTolFraction = 0.10;
+constexpr double kMeasuredBins_pct[4] = {70.5, 24.3, 4.6, 0.6};
+constexpr double kMeasuredBinsTol_pct[4] = {3.0, 3.0, 2.0, 1.0};
+constexpr int kEpochsCompared = 1081;
 
 TEST(ForestWalk, PednavGnssLandsOnSeed004Table1) {
   auto sc = io::load_scenario(test::source_path("datasets/forest_walk.yaml"));
@@ -32,9 +40,11 @@ TEST(ForestWalk, PednavGnssLandsOnSeed004Table1) {
   const double gen_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_TRUE(sum.has_value()) << (sum ? "" : sum.error().message);
   EXPECT_LT(gen_s, kMaxGenerate_s);
-  EXPECT_NEAR(sum->duration_s, 18 * 60.0, 5.0);
-  EXPECT_NEAR(sum->distance_m, 900.0, 20.0);
-  EXPECT_NEAR(sum->strides, 660, 15);
+  // Measured 2026-12-05: 1080.3 s, 899.4 m, 659 strides (the plan is deterministic): ±1 s, ±2 m, ±2 strides around
+  // the scenario's headline figures.
+  EXPECT_NEAR(sum->duration_s, 18 * 60.0, 1.0);
+  EXPECT_NEAR(sum->distance_m, 900.0, 2.0);
+  EXPECT_NEAR(sum->strides, 660, 2);
 
   auto cfg = io::load_run_config(dir + "/config.yaml");
   ASSERT_TRUE(cfg.has_value()) << (cfg ? "" : cfg.error().message);
@@ -52,9 +62,12 @@ TEST(ForestWalk, PednavGnssLandsOnSeed004Table1) {
               "5-10 %.1f %%, 10-20 %.1f %%, >=20 %.1f %%\n",
               gen_s, ev->epochs_compared, ev->horizontal_rms_m, ev->bins_pct[0], ev->bins_pct[1], ev->bins_pct[2],
               ev->bins_pct[3]);
-  EXPECT_GT(ev->epochs_compared, 1000);
-  EXPECT_NEAR(ev->horizontal_rms_m, kSeed004Rms_m, kRmsTolFraction * kSeed004Rms_m);
-  EXPECT_NEAR(ev->bins_pct[0], kSeed004Lt5_pct, kLt5Tol_pct);
+  EXPECT_EQ(ev->epochs_compared, kEpochsCompared);
+  EXPECT_NEAR(ev->horizontal_rms_m, kSeed004Rms_m, kRmsTolFraction * kSeed004Rms_m);  // seed 004 Table 1
+  EXPECT_NEAR(ev->bins_pct[0], kSeed004Lt5_pct, kLt5Tol_pct);                         // seed 004 Table 1
+  EXPECT_NEAR(ev->horizontal_rms_m, kMeasuredRms_m, kMeasuredRmsTolFraction * kMeasuredRms_m);
+  for (int b = 0; b < 4; ++b) EXPECT_NEAR(ev->bins_pct[b], kMeasuredBins_pct[b], kMeasuredBinsTol_pct[b]) << "bin " << b;
+  std::printf("forest_walk: %.1f s, %.1f m, %d strides\n", sum->duration_s, sum->distance_m, sum->strides);
 }
 
 }  // namespace

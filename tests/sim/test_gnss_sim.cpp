@@ -86,8 +86,16 @@ TEST(GnssSim, SdResidualsWithTruthHaveTheConfiguredSigmas) {
   const double ratio_code = std::sqrt(sc / res.size()), ratio_rate = std::sqrt(sr / res.size());
   std::printf("SD code residual std / configured %.3f, range rate %.3f (%zu residuals, mean sigma %.2f m)\n", ratio_code,
               ratio_rate, res.size(), atm_share / res.size());
-  EXPECT_NEAR(ratio_code, 1.0, kTolSigmaRatio);
+  EXPECT_NEAR(ratio_code, 1.0, kTolSigmaRatio);  // issue 4
   EXPECT_NEAR(ratio_rate, 1.0, kTolSigmaRatio);
+  // Measured 2026-12-05 (fixed seed, deterministic): 0.998 and 1.012 over 7467 residuals, mean σ 1.98 m. A sample σ
+  // ratio over N residuals spreads by ~1/√(2N) = 0.8 % for independent ones; the multipath (τ 20 s) correlates them,
+  // so a change of the random sequence (another draw order) may move it by a few %: ±3 % of 1 beside the issue's
+  // ±10 %. The residual count and the mean σ are functions of the scenario's geometry: ±1 %.
+  EXPECT_NEAR(ratio_code, 1.0, 0.03);
+  EXPECT_NEAR(ratio_rate, 1.0, 0.03);
+  EXPECT_NEAR(static_cast<double>(res.size()), 7467.0, 0.01 * 7467.0);
+  EXPECT_NEAR(atm_share / res.size(), 1.98, 0.01 * 1.98);
 }
 
 TEST(GnssSim, ResidualAtmosphereGrowsWithBaseline) {
@@ -103,7 +111,8 @@ TEST(GnssSim, ResidualAtmosphereGrowsWithBaseline) {
     return std::sqrt(s / v.size());
   };
   const double rn = rms(sd_residuals(*sn)), rf = rms(sd_residuals(*sf));
-  EXPECT_GT(rf, 5.0 * rn);  // 600 ppm x 5 km = 3 m / sin(el) vs < 1 m of receiver noise
+  // 600 ppm x 5 km = 3 m / sin(el) vs < 1 m of receiver noise. Measured 2026-12-05: 10.02 m vs 1.79 m (5.6×).
+  EXPECT_GT(rf, 5.0 * rn);
 }
 
 TEST(GnssSim, BlundersAppearAtTheConfiguredRateAndAreRecorded) {
@@ -128,7 +137,7 @@ TEST(GnssSim, BlundersAppearAtTheConfiguredRateAndAreRecorded) {
     EXPECT_LT(std::abs(it->second->code_m - b.error_m), 6.0 * it->second->sigma_code_m);
     ++checked;
   }
-  EXPECT_GT(checked, 20);
+  EXPECT_GT(checked, 178 * 10 / 13);  // measured 2026-12-05: 178 blunders seen at the base (63 events)
 }
 
 // sim::receiver_weight_model: the filter's eq. W1–W2 weights that describe the simulated receiver (pednav montecarlo
