@@ -377,10 +377,10 @@ TEST(Config, AutoSpecAndAutoThresholdAreFlagsAndMisspellingsAreNamed) {
   ASSERT_TRUE(given) << given.error().message;
   EXPECT_TRUE(given->zupt.edge_s_given);
   EXPECT_TRUE(given->zupt.zaru_gate_given);
-  EXPECT_DOUBLE_EQ(cfg->zupt.shoe_threshold_motion, 1.5);  // ins::AutoThresholdOptions' allowance
-  auto motion = parse(base + "zupt:\n  shoe_threshold: auto\n  shoe_threshold_motion: 2.5\n");
+  EXPECT_DOUBLE_EQ(cfg->zupt.shoe_threshold_motion, 2.5);  // ins::AutoThresholdOptions' allowance
+  auto motion = parse(base + "zupt:\n  shoe_threshold: auto\n  shoe_threshold_motion: 4\n");
   ASSERT_TRUE(motion) << motion.error().message;
-  EXPECT_DOUBLE_EQ(motion->zupt.shoe_threshold_motion, 2.5);
+  EXPECT_DOUBLE_EQ(motion->zupt.shoe_threshold_motion, 4.0);
   auto fixed = parse(base + "zupt:\n  shoe_threshold: 3\n  shoe_threshold_motion: 2.5\n");
   ASSERT_FALSE(fixed);
   EXPECT_THAT(fixed.error().message, HasSubstr("zupt.shoe_threshold_motion: only used with shoe_threshold: auto"));
