@@ -69,12 +69,16 @@ MagWalk& walk() {
 
 double wrap_deg(double a) { return std::remainder(a, 360.0); }
 
+// The walk's IMU without its GNSS (mode ins); no magnetometer attached yet.
+fusion::EngineInputs ins_only_inputs(const MagWalk& w) {
+  fusion::EngineInputs in;
+  in.imu = &w.sim.imu;
+  return in;
+}
+
 TEST(MagnetometerHeading, InitialYawFromTheFieldWithinTheLevellingTiltTimesTanDip) {
   MagWalk& w = walk();
-  fusion::EngineInputs in = test::engine_inputs(w.sim);
-  in.rover = nullptr;
-  in.base = nullptr;
-  in.nav = nullptr;
+  fusion::EngineInputs in = ins_only_inputs(w);
   in.mag_b = &w.mag_b;
   auto r = fusion::run_forward(in, w.options);
   ASSERT_TRUE(r) << r.error().message;
@@ -104,10 +108,7 @@ TEST(MagnetometerHeading, InitialYawFromTheFieldWithinTheLevellingTiltTimesTanDi
 
 TEST(MagnetometerHeading, NeedsOneFieldPerImuSample) {
   MagWalk& w = walk();
-  fusion::EngineInputs in = test::engine_inputs(w.sim);
-  in.rover = nullptr;
-  in.base = nullptr;
-  in.nav = nullptr;
+  fusion::EngineInputs in = ins_only_inputs(w);
   auto none = fusion::run_forward(in, w.options);
   ASSERT_FALSE(none);
   EXPECT_NE(none.error().message.find("heading from the magnetometer needs one magnetometer vector per IMU sample (got 0"),

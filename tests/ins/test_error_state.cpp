@@ -165,11 +165,17 @@ InsState sample_state_with_g() {
   return x;
 }
 
-TEST(ErrorState, GSensitivityColumnsOfFMatchNumericalDifferentiation) {
+// Central-difference steps for layout_with_g_sensitivity(): pos, vel, att, b_g, b_a, scale factors, G_g, clock.
+Eigen::VectorXd g_sensitivity_steps() {
   Eigen::VectorXd steps(32);
   steps << Eigen::Vector3d::Constant(1.0), Eigen::Vector3d::Constant(1e-4), Eigen::Vector3d::Constant(1e-5),
       Eigen::Vector3d::Constant(1e-5), Eigen::Vector3d::Constant(1e-5), Eigen::VectorXd::Constant(6, 1e-5),
       Eigen::VectorXd::Constant(9, 1e-6), Eigen::VectorXd::Constant(2, 1.0);
+  return steps;
+}
+
+TEST(ErrorState, GSensitivityColumnsOfFMatchNumericalDifferentiation) {
+  const Eigen::VectorXd steps = g_sensitivity_steps();
   // At Ĝ_g = 0: F leaves out the terms R Ĝ_g (δb_a + diag(f) δs_a) that the estimated g-sensitivity adds to the
   // attitude rows (docs/error_state.md §5: < 2 °/h for 5 mg of accelerometer bias error at forest_walk's σ).
   const ErrorStateLayout l = layout_with_g_sensitivity();
@@ -191,10 +197,7 @@ TEST(ErrorState, GSensitivityColumnsOfFMatchNumericalDifferentiation) {
 // (KalmanSizes.ConsiderStatesAreNotCorrectedAndPIsTheJosephFormOfTheirGain). This test pins that F is exact apart
 // from those two terms, and that they are what a nonzero Ĝ_g would need (the comparison fails without them).
 TEST(ErrorState, GSensitivityAtNonzeroEstimateLeavesOutOnlyTheAccelerometerCouplingTerms) {
-  Eigen::VectorXd steps(32);
-  steps << Eigen::Vector3d::Constant(1.0), Eigen::Vector3d::Constant(1e-4), Eigen::Vector3d::Constant(1e-5),
-      Eigen::Vector3d::Constant(1e-5), Eigen::Vector3d::Constant(1e-5), Eigen::VectorXd::Constant(6, 1e-5),
-      Eigen::VectorXd::Constant(9, 1e-6), Eigen::VectorXd::Constant(2, 1.0);
+  const Eigen::VectorXd steps = g_sensitivity_steps();
   const ErrorStateLayout l = layout_with_g_sensitivity();
   const InsState x = sample_state_with_g();
   const FPair F = continuous_f_pair(l, x, steps);

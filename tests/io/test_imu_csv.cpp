@@ -281,26 +281,22 @@ TEST(ImuCsv, MagnetometerColumnsInMicroteslaInTheBodyFrameAlignedWithTheSamples)
   EXPECT_THAT(all, HasSubstr("imu.csv:203: column 8 is 'x' (expected a finite number)"));
   EXPECT_TRUE(parse(os.str(), basic())->mag_b.empty());  // no mag columns in the format: nothing read
   // In a config: units, three columns, signs.
-  auto cfg = parse_run_config(
-      "mode: ins\nimu:\n  file: a.csv\n  format:\n    gyro: {columns: [1, 2, 3]}\n    accel: {columns: [4, 5, 6]}\n"
-      "    mag: {columns: [7, 8, 9], unit: nt, signs: [1, 1, -1]}\n",
-      "cfg.yaml", "/d");
+  auto with_mag = [](const std::string& mag_line) {
+    return parse_run_config("mode: ins\nimu:\n  file: a.csv\n  format:\n    gyro: {columns: [1, 2, 3]}\n"
+                            "    accel: {columns: [4, 5, 6]}\n" + mag_line,
+                            "cfg.yaml", "/d");
+  };
+  auto cfg = with_mag("    mag: {columns: [7, 8, 9], unit: nt, signs: [1, 1, -1]}\n");
   ASSERT_TRUE(cfg) << cfg.error().message;
   EXPECT_EQ(cfg->imu.format.mag_columns[2], 9);
   EXPECT_DOUBLE_EQ(cfg->imu.format.mag_scale_to_ut, 1e-3);
   EXPECT_EQ(cfg->imu.format.mag_signs.z(), -1.0);
-  auto bad = parse_run_config(
-      "mode: ins\nimu:\n  file: a.csv\n  format:\n    gyro: {columns: [1, 2, 3]}\n    accel: {columns: [4, 5, 6]}\n"
-      "    mag: {columns: [7, 8], unit: tesla, signs: [1, 2, 1]}\n",
-      "cfg.yaml", "/d");
+  auto bad = with_mag("    mag: {columns: [7, 8], unit: tesla, signs: [1, 2, 1]}\n");
   ASSERT_FALSE(bad);
   EXPECT_THAT(bad.error().message, HasSubstr("imu.format.mag.columns: expected 3 column indices, got 2"));
   EXPECT_THAT(bad.error().message, HasSubstr("imu.format.mag.unit: expected one of"));
   EXPECT_THAT(bad.error().message, HasSubstr("imu.format.mag: signs must each be 1 or -1"));
-  auto missing = parse_run_config(
-      "mode: ins\nimu:\n  file: a.csv\n  format:\n    gyro: {columns: [1, 2, 3]}\n    accel: {columns: [4, 5, 6]}\n"
-      "    mag: {unit: ut}\n",
-      "cfg.yaml", "/d");
+  auto missing = with_mag("    mag: {unit: ut}\n");
   ASSERT_FALSE(missing);
   EXPECT_THAT(missing.error().message, HasSubstr("imu.format.mag.columns: required key is missing"));
 }
