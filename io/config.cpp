@@ -145,6 +145,24 @@ std::string to_yaml(const RunConfig& c) {
     << "stride_velocity_sigma_horizontal_mps" << YAML::Value << c.antenna.stride_velocity_sigma_horizontal_mps
     << YAML::Key << "stride_velocity_sigma_vertical_mps" << YAML::Value
     << c.antenna.stride_velocity_sigma_vertical_mps << YAML::EndMap;
+  {
+    const InitialConfig& i = c.initial;
+    constexpr double kDeg = 180.0 / 3.14159265358979323846;
+    e << YAML::Key << "initial" << YAML::Value << YAML::BeginMap;
+    if (i.position_e) {
+      e << YAML::Key << "position_ecef_m" << YAML::Value << YAML::Flow
+        << std::vector<double>{i.position_e->x(), i.position_e->y(), i.position_e->z()};
+    }
+    if (i.yaw_rad) e << YAML::Key << "yaw_deg" << YAML::Value << *i.yaw_rad * kDeg;
+    if (i.heading_from_magnetometer) {
+      e << YAML::Key << "heading" << YAML::Value << "magnetometer" << YAML::Key << "declination_deg" << YAML::Value
+        << i.declination_rad * kDeg;
+    }
+    e << YAML::Key << "heading_init_distance_m" << YAML::Value << i.heading_init_distance_m << YAML::Key
+      << "sigma_position_m" << YAML::Value << i.sigma_position_m << YAML::Key << "sigma_velocity_mps" << YAML::Value
+      << i.sigma_velocity_mps << YAML::Key << "sigma_tilt_deg" << YAML::Value << i.sigma_tilt_rad * kDeg << YAML::Key
+      << "sigma_yaw_deg" << YAML::Value << i.sigma_yaw_rad * kDeg << YAML::EndMap;
+  }
   e << YAML::Key << "mechanization_rate_hz" << YAML::Value << c.mechanization_rate_hz;
   e << YAML::Key << "zupt" << YAML::Value << YAML::BeginMap << YAML::Key << "detector" << YAML::Value
     << c.zupt.detector << YAML::Key << "form" << YAML::Value << c.zupt.form << YAML::Key << "edge_s" << YAML::Value

@@ -419,5 +419,29 @@ TEST(Config, StepVelocityKeysRoundTripAndBadValuesAreNamed) {
   EXPECT_THAT(bad.error().message, HasSubstr("step_velocity.leg"));
 }
 
+// config.resolved.yaml carries the initial state a run used (a mode-ins run needs it to be rerun from that file).
+TEST(Config, InitialSectionRoundTrips) {
+  const std::string base = "mode: ins\nimu:\n  file: imu.csv\n  format: lord_sensorconnect\n  spec: gx5_25\n";
+  auto mag = parse(base + "initial: {lat_deg: 45, lon_deg: 7, h_m: 300, heading: magnetometer, declination_deg: 2.5, "
+                          "sigma_yaw_deg: 20, sigma_position_m: 0.5}\n");
+  ASSERT_TRUE(mag) << mag.error().message;
+  auto again = parse(to_yaml(*mag));
+  ASSERT_TRUE(again) << again.error().message;
+  ASSERT_TRUE(again->initial.position_e.has_value());
+  EXPECT_LT((*again->initial.position_e - *mag->initial.position_e).norm(), 1e-6);
+  EXPECT_TRUE(again->initial.heading_from_magnetometer);
+  EXPECT_NEAR(again->initial.declination_rad, mag->initial.declination_rad, 1e-12);
+  EXPECT_NEAR(again->initial.sigma_yaw_rad, mag->initial.sigma_yaw_rad, 1e-12);
+  EXPECT_DOUBLE_EQ(again->initial.sigma_position_m, 0.5);
+  EXPECT_FALSE(again->initial.yaw_rad.has_value());
+  auto yaw = parse(base + "initial: {lat_deg: 45, lon_deg: 7, h_m: 300, yaw_deg: -30}\n");
+  ASSERT_TRUE(yaw) << yaw.error().message;
+  auto yaw_again = parse(to_yaml(*yaw));
+  ASSERT_TRUE(yaw_again) << yaw_again.error().message;
+  ASSERT_TRUE(yaw_again->initial.yaw_rad.has_value());
+  EXPECT_NEAR(*yaw_again->initial.yaw_rad, *yaw->initial.yaw_rad, 1e-12);
+  EXPECT_FALSE(yaw_again->initial.heading_from_magnetometer);
+}
+
 }  // namespace
 }  // namespace pednav::io
