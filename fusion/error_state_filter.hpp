@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "core/column_sparse.hpp"
+#include "core/row_transition.hpp"
 #include "fusion/engine.hpp"
 #include "fusion/kalman.hpp"
 #include "fusion/rts.hpp"
@@ -177,7 +177,11 @@ class ErrorStateFilter {
   std::vector<double> mp_value_;
   std::vector<gnss::SatId> mp_sat_;
   std::vector<int64_t> mp_last_ns_;
-  ColumnSparse<ins::kMaxErrorDim> Phi_sparse_;
+  RowTransition<ins::kMaxErrorDim> Phi_rows_;  // Φ of the current step by its row structure
+  // The rows of Φ that can have off-diagonal entries: position, velocity, attitude (docs/error_state.md eq. 3.1-3.8)
+  // and the clocks (clock += drift dt); every other state is a random walk or Gauss-Markov state (RowTransition).
+  int dense_rows_[ins::kMaxErrorDim];
+  int n_dense_rows_ = 0, n_dense_rows_ins_ = 0;  // all; those before the first clock (the footprints' INS block)
   // Errors-in-variables compensation of the scale-factor estimates (docs/consistency.md §3.6). The scale column of
   // Φ is built from the measured increment, whose white noise ν also drives the error state: the noise part of
   // P's column of scale state s and the noise part of the error are both Σ_k g_k ν_k (times P_ss), so every update
@@ -194,9 +198,9 @@ class ErrorStateFilter {
   };
   std::vector<EivTerm> eiv_;
   std::vector<EivTerm> eivo_;  // the same for the smoother's Kalman-gain filter (consider states, docs/fusion.md §12.6)
-  ErrorMatrix eiv_tmp_, eiv_zero_;
+  ErrorMatrix eiv_tmp_;
   int eiv_dim_ = 0;
-  ColumnSparse<ins::kMaxErrorDim> eiv_Phi_;
+  RowTransition<ins::kMaxErrorDim> eiv_Phi_;  // the INS block of Φ (footprints over the INS states only)
 
   void eiv_predict(double dt, const ins::NavState& before, const ins::NavState& after, std::vector<EivTerm>& terms,
                    const ErrorMatrix& P);
