@@ -13,6 +13,8 @@
 #include <array>
 #include <cassert>
 
+#include "core/vector_kernels.hpp"
+
 namespace pednav {
 
 /// Φ (n × n, n ≤ kMaxDim) by rows: dense rows by their nonzeros, the other rows by their diagonal entry.
@@ -165,20 +167,27 @@ class RowTransition {
         continue;
       }
       double* const pj = p0 + j * ldp;
-      if (!all_unit_) scale_column(n, d_[j], d_.data(), pj);
-      if constexpr (kWithQ) add_column(n, q0 + j * ldq, pj);
+      if (!all_unit_) kernels::scale_by_outer(n, d_[j], d_.data(), pj);
+      if constexpr (kWithQ) kernels::add(n, q0 + j * ldq, pj);
     }
-    // Dense columns j = g_k: P(i, j) = d_i U(i, k) in the other rows, Φ(g_l, :) U(:, k) in dense rows g_l with
-    // l ≤ k (l > k: set by symmetry when column g_l is done), + Q(i, j); column j is then mirrored into row j.
-    for (k = 0; k < n_dense_; ++k) {
+    // The dense block Z = Φ_G U (m × m, Z_lk = Φ(g_l, :) U(:, k)) by columns of Zᵀ: Zᵀ(:, l) = Σ_e Φ(g_l, c_e) Uᵀ(:, c_e),
+    // sums of whole columns of Uᵀ (m × n, transposed once).
+    const int m = n_dense_;
+    double Ut[kMaxDim * kMaxDim];  // not initialized: every entry read is written first
+    double Zt[kMaxDim * kMaxDim];
+    for (int kk = 0; kk < m; ++kk) {
+      for (int i = 0; i < n; ++i) Ut[kk + i * m] = u0[i + kk * ldu];
+    }
+    times_dense_rows_into(Ut, m, m, Zt);
+    // Dense columns j = g_k: P(i, j) = d_i U(i, k) in the other rows, Z_lk in dense rows g_l with l ≤ k (l > k: set
+    // by symmetry when column g_l is done), + Q(i, j); column j is then mirrored into row j.
+    for (k = 0; k < m; ++k) {
       const int j = dense_[k];
       double* const pj = p0 + j * ldp;
-      const double* const uk = u0 + k * ldu;
-      diagonal_times(n, d_.data(), uk, pj);
-      if constexpr (kWithQ) add_column(n, q0 + j * ldq, pj);
+      kernels::multiply(n, d_.data(), u0 + k * ldu, pj);
+      if constexpr (kWithQ) kernels::add(n, q0 + j * ldq, pj);
       for (int l = 0; l <= k; ++l) {
-        double s = 0.0;
-        for (int e = start_[l]; e < start_[l + 1]; ++e) s += val_[e] * uk[col_[e]];
+        double s = Zt[k + l * m];
         if constexpr (kWithQ) s += q0[dense_[l] + j * ldq];
         pj[dense_[l]] = s;
       }
@@ -186,52 +195,31 @@ class RowTransition {
     }
   }
 
-  // Column kernels over n contiguous entries (restrict parameters: vectorized without run-time alias checks).
-  static void scale_column(Eigen::Index n, double dj, const double* __restrict d, double* __restrict p) {
-    for (Eigen::Index i = 0; i < n; ++i) p[i] *= d[i] * dj;
-  }
-  static void add_column(Eigen::Index n, const double* __restrict q, double* __restrict p) {
-    for (Eigen::Index i = 0; i < n; ++i) p[i] += q[i];
-  }
-  static void diagonal_times(Eigen::Index n, const double* __restrict d, const double* __restrict u,
-                             double* __restrict p) {
-    for (Eigen::Index i = 0; i < n; ++i) p[i] = d[i] * u[i];
-  }
-
-  // u = Σ v_e a_e or u += Σ v_e a_e over n contiguous entries, four or two terms per pass over u (restrict
-  // parameters: vectorized without run-time alias checks; fewer loads and stores of u than one term per pass).
-  static void axpy4(Eigen::Index n, const double* v, const double* __restrict a0, const double* __restrict a1,
-                    const double* __restrict a2, const double* __restrict a3, double* __restrict u) {
-    for (Eigen::Index i = 0; i < n; ++i) u[i] += (v[0] * a0[i] + v[1] * a1[i]) + (v[2] * a2[i] + v[3] * a3[i]);
-  }
-  static void axpy2(Eigen::Index n, const double* v, const double* __restrict a0, const double* __restrict a1,
-                    double* __restrict u) {
-    for (Eigen::Index i = 0; i < n; ++i) u[i] += v[0] * a0[i] + v[1] * a1[i];
-  }
-  static void axpy1(Eigen::Index n, double v, const double* __restrict a, double* __restrict u) {
-    for (Eigen::Index i = 0; i < n; ++i) u[i] += v * a[i];
-  }
-
-  // U(:, k) = Σ_c Φ(g_k, c) A(:, c): the dense rows' part of A Φᵀ, as sums of whole columns of A (plain loops over
-  // contiguous memory: at these sizes Eigen's per-expression set-up costs as much as the arithmetic).
+  // U(:, k) = Σ_c Φ(g_k, c) A(:, c): the dense rows' part of A Φᵀ, as sums of whole columns of A, four columns per
+  // pass over U(:, k) (core/vector_kernels: at these sizes Eigen's per-expression set-up costs as much as the
+  // arithmetic).
   template <typename MatA, typename MatU>
   void times_transposed_dense_rows(const MatA& A, MatU& U) const {
-    const Eigen::Index rows = A.rows(), lda = A.outerStride(), ldu = U.outerStride();
-    const double* const a0 = A.data();
+    times_dense_rows_into(A.data(), A.outerStride(), A.rows(), U.data(), U.outerStride());
+  }
+  // The same on raw column-major storage: A (rows × n, leading dimension lda) into U (rows × dense_rows(), ldu).
+  void times_dense_rows_into(const double* a0, Eigen::Index lda, Eigen::Index rows, double* u0,
+                             Eigen::Index ldu = -1) const {
+    if (ldu < 0) ldu = rows;
     for (int k = 0; k < n_dense_; ++k) {
-      double* const u = U.data() + k * ldu;
+      double* const u = u0 + k * ldu;
       for (Eigen::Index i = 0; i < rows; ++i) u[i] = 0.0;
       int e = start_[k];
       const int end = start_[k + 1];
       for (; e + 4 <= end; e += 4) {
-        axpy4(rows, &val_[e], a0 + col_[e] * lda, a0 + col_[e + 1] * lda, a0 + col_[e + 2] * lda,
-              a0 + col_[e + 3] * lda, u);
+        kernels::axpy4(rows, &val_[e], a0 + col_[e] * lda, a0 + col_[e + 1] * lda, a0 + col_[e + 2] * lda,
+                       a0 + col_[e + 3] * lda, u);
       }
       if (e + 2 <= end) {
-        axpy2(rows, &val_[e], a0 + col_[e] * lda, a0 + col_[e + 1] * lda, u);
+        kernels::axpy2(rows, &val_[e], a0 + col_[e] * lda, a0 + col_[e + 1] * lda, u);
         e += 2;
       }
-      if (e < end) axpy1(rows, val_[e], a0 + col_[e] * lda, u);
+      if (e < end) kernels::axpy1(rows, val_[e], a0 + col_[e] * lda, u);
     }
   }
 

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include "core/row_transition.hpp"
+#include "core/vector_kernels.hpp"
 #include "ins/error_state.hpp"
 
 namespace pednav::fusion {
@@ -54,25 +55,24 @@ inline int nonzero_columns(const MatH& H, int* nz) {
 /// X ← (I − K H) X (I − K H)ᵀ + K R Kᵀ for a symmetric X given U = X Hᵀ (n × m) and S = H U + R (m × m, symmetric):
 /// X − K Wᵀ − W Kᵀ with W = U − ½ K S (docs/fusion.md eq. 6.4), a symmetric rank-2m update on the upper triangle,
 /// mirrored — n(n+1)·m multiply-adds. With R = 0 it is the plain (I − K H) X (I − K H)ᵀ. X: a matrix or a block of
-/// one (column-major, unit inner stride); K likewise. The column updates are plain loops over contiguous memory:
+/// one (column-major, unit inner stride); K likewise. The column updates are kernels over contiguous memory:
 /// at the engine's sizes (n ≤ 48, m = 6) Eigen's per-expression set-up cost more than the arithmetic, and a GEMM
 /// (Y = W Kᵀ, X − Y − Yᵀ, or the triangular product) more than both (issue 39, docs/performance.md §1).
 template <typename MatX, typename MatU, typename MatK, typename MatS>
 inline void gain_downdate(MatX& X, const MatU& U, const MatK& K, const MatS& S) {
-  MatU W = U;
-  W.noalias() -= 0.5 * (K * S);
   const Eigen::Index n = X.rows(), m = K.cols();
+  MatU W = U;  // W = U − ½ K S, by columns: W(:, k) −= ½ S(l, k) K(:, l)
+  for (Eigen::Index k = 0; k < m; ++k) {
+    for (Eigen::Index l = 0; l < m; ++l) kernels::axpy1(n, -0.5 * S(l, k), K.col(l).data(), W.col(k).data());
+  }
   const Eigen::Index ldx = X.outerStride(), ldk = K.outerStride(), ldw = W.outerStride();
   double* const x0 = X.data();
   const double* const k0 = K.data();
   const double* const w0 = W.data();
   for (Eigen::Index j = 0; j < n; ++j) {
-    double* __restrict x = x0 + j * ldx;
+    double* const x = x0 + j * ldx;
     for (Eigen::Index k = 0; k < m; ++k) {
-      const double a = w0[j + k * ldw], b = k0[j + k * ldk];
-      const double* __restrict kc = k0 + k * ldk;
-      const double* __restrict wc = w0 + k * ldw;
-      for (Eigen::Index i = 0; i <= j; ++i) x[i] -= a * kc[i] + b * wc[i];
+      kernels::rank2_downdate(j + 1, w0[j + k * ldw], k0 + k * ldk, k0[j + k * ldk], w0 + k * ldw, x);
     }
   }
   mirror_upper(X);
