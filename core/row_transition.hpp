@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // A state transition Φ stored by its row structure, and the covariance products the filter and the smoother need
-// with it (docs/performance.md §1, issue 39). The error state of the engine has a few "dense" rows (navigation
+// with it (docs/performance.md §5, issue 39). The error state of the engine has a few "dense" rows (navigation
 // states: position, velocity, attitude; the receiver clock) and many unit or scaled-unit rows (random-walk and
 // Gauss-Markov states: biases, scale factors, drift, multipath slots, consider states: Φ_rr = d_r and nothing else
 // in the row). With G the dense rows and D = diag(d) the others, P ← Φ P Φᵀ + Q costs the products with Φ's

@@ -2,7 +2,7 @@
 // The innermost loops of the filter's covariance algebra (core/row_transition.hpp, fusion/kalman.hpp): short sums
 // of scaled columns over contiguous memory. Compiled twice (GCC/Clang target_clones: AVX2 and the baseline x86-64
 // SSE2) and chosen once at load time by the CPU; neither clone uses FMA, so both give bit-identical results on
-// every machine — only the vector width differs (issue 39, docs/performance.md §1).
+// every machine — only the vector width differs (issue 39, docs/performance.md §5).
 #pragma once
 
 #include <cstddef>

@@ -36,7 +36,7 @@ inline void mirror_upper(Mat& A) {
 /// navigation states and the clock); the unit and scaled-unit rows of the random-walk and Gauss-Markov states
 /// (biases, scale factors, drift, multipath slots, consider states) cost one scaling of their entries of P:
 /// U = P Φ_Gᵀ, then P_DD ← d dᵀ ∘ P_DD, P_DG ← D U_D, P_GG ← Φ_G U, + Q_d, computed in place and exactly symmetric
-/// (docs/performance.md §1). tmp: scratch (n × number of dense rows on return).
+/// (docs/performance.md §5). tmp: scratch (n × number of dense rows on return).
 inline void covariance_predict(ins::ErrorMatrix& P, const RowTransition<ins::kMaxErrorDim>& Phi,
                                const ins::ErrorMatrix& Qd, ins::ErrorMatrix& tmp) {
   Phi.propagate_symmetric(P, Qd, tmp);
@@ -57,7 +57,7 @@ inline int nonzero_columns(const MatH& H, int* nz) {
 /// mirrored — n(n+1)·m multiply-adds. With R = 0 it is the plain (I − K H) X (I − K H)ᵀ. X: a matrix or a block of
 /// one (column-major, unit inner stride); K likewise. The column updates are kernels over contiguous memory:
 /// at the engine's sizes (n ≤ 48, m = 6) Eigen's per-expression set-up cost more than the arithmetic, and a GEMM
-/// (Y = W Kᵀ, X − Y − Yᵀ, or the triangular product) more than both (issue 39, docs/performance.md §1).
+/// (Y = W Kᵀ, X − Y − Yᵀ, or the triangular product) more than both (issue 39, docs/performance.md §5).
 template <typename MatX, typename MatU, typename MatK, typename MatS>
 inline void gain_downdate(MatX& X, const MatU& U, const MatK& K, const MatS& S) {
   const Eigen::Index n = X.rows(), m = K.cols();

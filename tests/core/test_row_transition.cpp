@@ -85,7 +85,8 @@ TEST_P(RowTransitionSizes, ProductsEqualTheDenseOnesAndPStaysSymmetric) {
   for (int i = 0; i < n; ++i) x(i) = nd(rng);
   const Eigen::VectorXd expected_x = F * Eigen::VectorXd(x);
   T.times_in_place(x, tmp);
-  EXPECT_LT((Eigen::VectorXd(x) - expected_x).cwiseAbs().maxCoeff(), kTolRel * expected_x.cwiseAbs().maxCoeff() + 1e-15);
+  EXPECT_LT((Eigen::VectorXd(x) - expected_x).cwiseAbs().maxCoeff(),
+            kTolRel * expected_x.cwiseAbs().maxCoeff() + 1e-15);
 }
 
 TEST(RowTransition, IdentityLeavesPAndAddsQ) {
