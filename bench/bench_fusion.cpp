@@ -16,7 +16,7 @@
 #include <random>
 #include <string>
 
-#include "core/column_sparse.hpp"
+#include "core/row_transition.hpp"
 #include "core/geodesy.hpp"
 #include "fusion/engine.hpp"
 #include "fusion/kalman.hpp"
@@ -87,11 +87,11 @@ void BM_CovariancePrediction17(benchmark::State& st) {
   const ins::NavState b = ins::mechanize(a, inc);
   ErrorMatrix P = random_spd(layout.dim(), 1u), tmp;
   const ErrorMatrix P0 = P;
-  ColumnSparse<ins::kMaxErrorDim> Phi;
+  RowTransition<ins::kMaxErrorDim> Phi;
   AllocCounter allocs;
   for (auto _ : st) {
     const ins::DiscreteErrorModel m = ins::interval_error_model(layout, spec, a, b, inc);
-    Phi.assign(m.Phi);  // as the engine: Φ by its non-zeros
+    Phi.assign(m.Phi);  // as the engine: Φ by its row structure
     fusion::covariance_predict(P, Phi, m.Qd, tmp);
     if (P(0, 0) > 1e6) P = P0;
     benchmark::DoNotOptimize(P.data());
@@ -275,7 +275,7 @@ void BM_SmootherIntervalStep(benchmark::State& st) {
   const ins::ImuIncrement inc = increment();
   const ins::NavState b = ins::mechanize(a, inc);
   const ins::DiscreteErrorModel model = ins::interval_error_model(layout, spec, a, b, inc);
-  ColumnSparse<ins::kMaxErrorDim> Phi;
+  RowTransition<ins::kMaxErrorDim> Phi;
   Phi.assign(model.Phi);
   const ErrorMatrix P = random_spd(n, 4u);
   using K6 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, ins::kMaxErrorDim, 6>;

@@ -102,6 +102,11 @@ ErrorStateFilter::ErrorStateFilter(const EngineOptions& o, int n_clocks) : o_(o)
     }
   }
   clock_m_.assign(n_clocks, 0.0);
+  for (const ins::Block& b : {ins::kPos, ins::kVel, ins::kAtt}) {
+    for (int i = 0; i < b.dim; ++i) dense_rows_[n_dense_rows_++] = b.offset + i;
+  }
+  n_dense_rows_ins_ = n_dense_rows_;
+  for (const auto& b : clock_blocks_) dense_rows_[n_dense_rows_++] = b.offset;
 }
 
 void ErrorStateFilter::init(const ins::NavState& nav, const ins::ImuErrors& imu, double sigma_yaw_rad) {
@@ -191,18 +196,17 @@ void ErrorStateFilter::predict(const ins::ImuIncrement& inc) {
       mp_value_[i] *= e;
     }
   }
-  Phi_sparse_.assign(m.Phi);
+  Phi_rows_.assign(m.Phi, dense_rows_, n_dense_rows_);
   // Smoother: the cross-covariance of the error at the last output epoch with the current error, Γ ← Γ Φᵀ
   // (docs/fusion.md eq. 12.15).
-  if (recording_) interval_.predict(Phi_sparse_);
+  if (recording_) interval_.predict(Phi_rows_);
   if (!eiv_.empty()) eiv_predict(inc.dt_s, x_.nav, after, eiv_, P_);
   if (shadow_ && !eivo_.empty()) eiv_predict(inc.dt_s, x_.nav, after, eivo_, Po_);
   if (shadow_) {  // the Kalman-gain filter of the smoother (docs/fusion.md eq. 12.22): η ← Φ η, P_o ← Φ P_o Φᵀ + Q_d
-    Phi_sparse_.times(eta_, eta_tmp_);
-    eta_ = eta_tmp_;
-    covariance_predict(Po_, Phi_sparse_, m.Qd, tmp_);
+    Phi_rows_.times_in_place(eta_, eta_tmp_);
+    covariance_predict(Po_, Phi_rows_, m.Qd, tmp_);
   }
-  covariance_predict(P_, Phi_sparse_, m.Qd, tmp_);
+  covariance_predict(P_, Phi_rows_, m.Qd, tmp_);
   x_.nav = after;
 }
 
@@ -375,15 +379,14 @@ double ErrorStateFilter::eiv_correction(int state) const {
 void ErrorStateFilter::eiv_predict(double dt, const ins::NavState& before, const ins::NavState& after, std::vector<EivTerm>& terms,
                  const ErrorMatrix& P) {
   const int n = terms.empty() ? 0 : static_cast<int>(terms.front().M.rows());
-  if (eiv_zero_.rows() != n) eiv_zero_.setZero(n, n);
-  if (n != layout_.dim()) eiv_Phi_.assign(model_.Phi.topLeftCorner(n, n));
-  const auto& Phi = n != layout_.dim() ? eiv_Phi_ : Phi_sparse_;
+  if (n != layout_.dim()) eiv_Phi_.assign(model_.Phi.topLeftCorner(n, n), dense_rows_, n_dense_rows_ins_);
+  const auto& Phi = n != layout_.dim() ? eiv_Phi_ : Phi_rows_;
   const Eigen::Matrix3d R = before.q_e_b.slerp(0.5, after.q_e_b).toRotationMatrix();
   // The noise ν_u of every scale term u's regressor enters P's column of scale state t through P_tu (its own column
   // of Φ times P_{s_u s_t}), and the error through g_u: M_t gains Σ_u P_tu σ_u² Δt g_u g_uᵀ (docs/consistency.md
   // eq. E.5; only u = t in session 9).
   for (auto& t : terms) {
-    covariance_predict(t.M, Phi, eiv_zero_, eiv_tmp_);
+    Phi.propagate_symmetric(t.M, eiv_tmp_);  // Φ M Φᵀ: no process noise of its own
     for (const auto& u : terms) {
       const double psd = u.gyro ? spec_.gyro_arw * spec_.gyro_arw : spec_.accel_vrw * spec_.accel_vrw;
       const Vector3d g = R.col(u.axis);

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "core/column_sparse.hpp"
+#include "core/row_transition.hpp"
 #include "fusion/engine.hpp"
 #include "fusion/kalman.hpp"
 #include "fusion/rts.hpp"
@@ -177,7 +177,11 @@ class ErrorStateFilter {
   std::vector<double> mp_value_;
   std::vector<gnss::SatId> mp_sat_;
   std::vector<int64_t> mp_last_ns_;
-  ColumnSparse<ins::kMaxErrorDim> Phi_sparse_;
+  RowTransition<ins::kMaxErrorDim> Phi_rows_;  // Φ of the current step by its row structure
+  // The rows of Φ that can have off-diagonal entries: position, velocity, attitude (docs/error_state.md eq. 3.1-3.8)
+  // and the clocks (clock += drift dt); every other state is a random walk or Gauss-Markov state (RowTransition).
+  int dense_rows_[ins::kMaxErrorDim];
+  int n_dense_rows_ = 0, n_dense_rows_ins_ = 0;  // all; those before the first clock (the footprints' INS block)
   // Errors-in-variables compensation of the scale-factor estimates (docs/consistency.md §3.6). The scale column of
   // Φ is built from the measured increment, whose white noise ν also drives the error state: the noise part of
   // P's column of scale state s and the noise part of the error are both Σ_k g_k ν_k (times P_ss), so every update
@@ -194,9 +198,9 @@ class ErrorStateFilter {
   };
   std::vector<EivTerm> eiv_;
   std::vector<EivTerm> eivo_;  // the same for the smoother's Kalman-gain filter (consider states, docs/fusion.md §12.6)
-  ErrorMatrix eiv_tmp_, eiv_zero_;
+  ErrorMatrix eiv_tmp_;
   int eiv_dim_ = 0;
-  ColumnSparse<ins::kMaxErrorDim> eiv_Phi_;
+  RowTransition<ins::kMaxErrorDim> eiv_Phi_;  // the INS block of Φ (footprints over the INS states only)
 
   void eiv_predict(double dt, const ins::NavState& before, const ins::NavState& after, std::vector<EivTerm>& terms,
                    const ErrorMatrix& P);
@@ -207,7 +211,11 @@ class ErrorStateFilter {
     if (terms.empty()) return;
     int nz[ins::kMaxErrorDim];
     const int n_nz = nonzero_columns(H, nz);
-    for (size_t j = 0; j < terms.size(); ++j) bias[j] = eiv_update(terms[j].M, H, nz, n_nz, S_ldlt, K);
+    using SMat = Eigen::Matrix<double, MatH::RowsAtCompileTime, MatH::RowsAtCompileTime, Eigen::ColMajor,
+                               MatH::MaxRowsAtCompileTime, MatH::MaxRowsAtCompileTime>;
+    SMat S_inv = SMat::Identity(H.rows(), H.rows());
+    S_ldlt.solveInPlace(S_inv);  // once per update, shared by the terms
+    for (size_t j = 0; j < terms.size(); ++j) bias[j] = eiv_update(terms[j].M, H, nz, n_nz, S_inv, K);
   }
   // Subtract the mean noise parts from the correction dx (docs/consistency.md eq. E.4) and, with shift_interval,
   // remove the same bias from the smoother interval's mean: in every component by regression on the scale states
@@ -218,21 +226,29 @@ class ErrorStateFilter {
                     const ErrorMatrix& P);
 
   // The mean noise-noise part of K_s r for one scale state, tr(S⁻¹ H M Hᵀ), and M ← (I − K H) M (I − K H)ᵀ. H of a
-  // ZUPT or GNSS epoch touches a few states only: M Hᵀ is summed over H's non-zero columns nz[0..n_nz).
-  template <typename MatH, typename Ldlt, typename MatK>
-  double eiv_update(ErrorMatrix& M, const MatH& H, const int* nz, int n_nz, const Ldlt& S_ldlt, const MatK& K) {
+  // ZUPT or GNSS epoch touches a few states only: U = M Hᵀ and B = H U are summed over H's non-zero columns
+  // nz[0..n_nz) (columns of M through core/vector_kernels, no small-GEMM set-up); S_inv = S⁻¹ (symmetric).
+  template <typename MatH, typename MatSinv, typename MatK>
+  double eiv_update(ErrorMatrix& M, const MatH& H, const int* nz, int n_nz, const MatSinv& S_inv, const MatK& K) {
     const int ne = static_cast<int>(M.rows());
     if (ne > H.cols()) return 0.0;
     using UMat = Eigen::Matrix<double, Eigen::Dynamic, MatH::RowsAtCompileTime, Eigen::ColMajor, ins::kMaxErrorDim,
                                MatH::MaxRowsAtCompileTime>;
     using SMat = Eigen::Matrix<double, MatH::RowsAtCompileTime, MatH::RowsAtCompileTime, Eigen::ColMajor,
                                MatH::MaxRowsAtCompileTime, MatH::MaxRowsAtCompileTime>;
+    const int m = static_cast<int>(H.rows());
     UMat U;  // M Hᵀ
-    U.setZero(ne, H.rows());
-    for (int k = 0; k < n_nz && nz[k] < ne; ++k) U.noalias() += M.col(nz[k]) * H.col(nz[k]).head(ne).transpose();
-    SMat B;  // H M Hᵀ
-    B.noalias() = H.leftCols(ne) * U;
-    const double bias = S_ldlt.solve(B).trace();
+    U.setZero(ne, m);
+    for (int i = 0; i < m; ++i) {
+      for (int k = 0; k < n_nz && nz[k] < ne; ++k) {
+        const double h = H(i, nz[k]);
+        if (h != 0.0) kernels::axpy1(ne, h, M.col(nz[k]).data(), U.col(i).data());
+      }
+    }
+    SMat B;  // H M Hᵀ = H U
+    B.setZero(m, m);
+    for (int k = 0; k < n_nz && nz[k] < ne; ++k) B.noalias() += H.col(nz[k]) * U.row(nz[k]);
+    const double bias = S_inv.cwiseProduct(B).sum();  // tr(S⁻¹ B) with S⁻¹ and B symmetric
     // (I − K H) M (I − K H)ᵀ on the INS block: the noise-free form (R = 0) of the Joseph update.
     gain_downdate(M, U, K.topRows(ne), B);
     return bias;

@@ -7,7 +7,8 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
-#include "core/column_sparse.hpp"
+#include "core/row_transition.hpp"
+#include "core/vector_kernels.hpp"
 #include "ins/error_state.hpp"
 
 namespace pednav::fusion {
@@ -31,19 +32,14 @@ inline void mirror_upper(Mat& A) {
   }
 }
 
-/// The same with Φ given by its nonzeros (Φ of the INS error model is mostly zeros): P ← Φ P Φᵀ + Q_d; on return
-/// tmp = Φ P (the prior P). Both products are sums of whole columns (contiguous, vectorized): P Φᵀ column by column,
-/// then Φ P = (P Φᵀ)ᵀ as P is symmetric, and Φ P Φᵀ = (Φ P) Φᵀ the same way, on the upper triangle only (the result
-/// is symmetric), mirrored into the lower one (docs/performance.md §1).
-inline void covariance_predict(ins::ErrorMatrix& P, const ColumnSparse<ins::kMaxErrorDim>& Phi,
+/// The same with Φ by its row structure (core/row_transition.hpp): the products run over Φ's dense rows only (the
+/// navigation states and the clock); the unit and scaled-unit rows of the random-walk and Gauss-Markov states
+/// (biases, scale factors, drift, multipath slots, consider states) cost one scaling of their entries of P:
+/// U = P Φ_Gᵀ, then P_DD ← d dᵀ ∘ P_DD, P_DG ← D U_D, P_GG ← Φ_G U, + Q_d, computed in place and exactly symmetric
+/// (docs/performance.md §5). tmp: scratch (n × number of dense rows on return).
+inline void covariance_predict(ins::ErrorMatrix& P, const RowTransition<ins::kMaxErrorDim>& Phi,
                                const ins::ErrorMatrix& Qd, ins::ErrorMatrix& tmp) {
-  ins::ErrorMatrix PPhit;
-  PPhit.setZero(P.rows(), P.cols());
-  Phi.add_times_transposed(P, PPhit);  // P Φᵀ
-  tmp = PPhit.transpose();             // Φ P
-  P = Qd;
-  Phi.add_times_transposed_upper(tmp, P);  // upper triangle of Q_d + Φ P Φᵀ
-  mirror_upper(P);
+  Phi.propagate_symmetric(P, Qd, tmp);
 }
 
 /// The indices of H's columns that are not all zero, in increasing order, into nz (capacity H.cols()); their count.
@@ -58,16 +54,25 @@ inline int nonzero_columns(const MatH& H, int* nz) {
 
 /// X ← (I − K H) X (I − K H)ᵀ + K R Kᵀ for a symmetric X given U = X Hᵀ (n × m) and S = H U + R (m × m, symmetric):
 /// X − K Wᵀ − W Kᵀ with W = U − ½ K S (docs/fusion.md eq. 6.4), a symmetric rank-2m update on the upper triangle,
-/// mirrored — n(n+1)·m multiply-adds. With R = 0 it is the plain (I − K H) X (I − K H)ᵀ.
-template <typename MatU, typename MatK, typename MatS>
-inline void gain_downdate(ins::ErrorMatrix& X, const MatU& U, const MatK& K, const MatS& S) {
-  MatU W = U;
-  W.noalias() -= 0.5 * (K * S);
-  const Eigen::Index n = X.rows();
+/// mirrored — n(n+1)·m multiply-adds. With R = 0 it is the plain (I − K H) X (I − K H)ᵀ. X: a matrix or a block of
+/// one (column-major, unit inner stride); K likewise. The column updates are kernels over contiguous memory:
+/// at the engine's sizes (n ≤ 48, m = 6) Eigen's per-expression set-up cost more than the arithmetic, and a GEMM
+/// (Y = W Kᵀ, X − Y − Yᵀ, or the triangular product) more than both (issue 39, docs/performance.md §5).
+template <typename MatX, typename MatU, typename MatK, typename MatS>
+inline void gain_downdate(MatX& X, const MatU& U, const MatK& K, const MatS& S) {
+  const Eigen::Index n = X.rows(), m = K.cols();
+  MatU W = U;  // W = U − ½ K S, by columns: W(:, k) −= ½ S(l, k) K(:, l)
+  for (Eigen::Index k = 0; k < m; ++k) {
+    for (Eigen::Index l = 0; l < m; ++l) kernels::axpy1(n, -0.5 * S(l, k), K.col(l).data(), W.col(k).data());
+  }
+  const Eigen::Index ldx = X.outerStride(), ldk = K.outerStride(), ldw = W.outerStride();
+  double* const x0 = X.data();
+  const double* const k0 = K.data();
+  const double* const w0 = W.data();
   for (Eigen::Index j = 0; j < n; ++j) {
-    auto Xj = X.col(j).head(j + 1);
-    for (Eigen::Index k = 0; k < K.cols(); ++k) {
-      Xj -= W(j, k) * K.col(k).head(j + 1) + K(j, k) * W.col(k).head(j + 1);
+    double* const x = x0 + j * ldx;
+    for (Eigen::Index k = 0; k < m; ++k) {
+      kernels::rank2_downdate(j + 1, w0[j + k * ldw], k0 + k * ldk, k0[j + k * ldk], w0 + k * ldw, x);
     }
   }
   mirror_upper(X);

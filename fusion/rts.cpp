@@ -81,11 +81,10 @@ void RtsInterval::restart(const ErrorMatrix& P_a, const ErrorVector& eta_a) {
   mu_ = eta_a;  // eq. 12.21: E[δx_a | Y_a] = η_a
 }
 
-void RtsInterval::predict(const ColumnSparse<ins::kMaxErrorDim>& Phi) {
-  // Γ ← Γ Φᵀ as sums of whole columns, (Γ Φᵀ).col(r) += Φ_rc Γ.col(c), as the filter's P Φᵀ (eq. 12.15).
-  tmp_.setZero(Gamma_.rows(), Gamma_.cols());
-  Phi.add_times_transposed(Gamma_, tmp_);
-  Gamma_ = tmp_;
+void RtsInterval::predict(const RowTransition<ins::kMaxErrorDim>& Phi) {
+  // Γ ← Γ Φᵀ in place (eq. 12.15): the columns of Φ's dense rows as sums of whole columns of Γ, the others scaled
+  // by Φ_rr (or left alone when it is 1).
+  Phi.times_transposed_in_place(Gamma_, tmp_);
   ++steps_;
 }
 

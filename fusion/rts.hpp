@@ -14,7 +14,7 @@
 #include <functional>
 #include <vector>
 
-#include "core/column_sparse.hpp"
+#include "core/row_transition.hpp"
 #include "ins/error_state.hpp"
 
 namespace pednav::fusion {
@@ -89,8 +89,9 @@ class RtsInterval {
   /// The same when the filter's error at a has a known non-zero conditional mean η_a = E[δx_a | Y_a] and P_a is
   /// Var(δx_a | Y_a): μ = η_a (the smoother of a filter with consider states, docs/fusion.md §12.6, eq. 12.21).
   void restart(const ErrorMatrix& P_a, const ErrorVector& eta_a);
-  /// Prediction δx⁻ = Φ δx + w (w independent of δx_a): Γ ← Γ Φᵀ (eq. 12.15), Φ by its non-zeros.
-  void predict(const ColumnSparse<ins::kMaxErrorDim>& Phi);
+  /// Prediction δx⁻ = Φ δx + w (w independent of δx_a): Γ ← Γ Φᵀ (eq. 12.15), Φ by its row structure: products
+  /// over Φ's dense rows only; the columns of unit rows stay, those of scaled-unit rows are scaled.
+  void predict(const RowTransition<ins::kMaxErrorDim>& Phi);
   /// The same with a dense Φ.
   void predict(const ErrorMatrix& Phi);
   /// A Kalman update of the filter with residual r (measured − predicted), Jacobian H (m × n), the factorization

@@ -32,6 +32,23 @@ std::vector<std::string> split(const std::string& s, char sep) {
   return out;
 }
 
+// The same into `out`, reused from line to line (its strings keep their capacity: no allocation per line once the
+// cells are as long as the longest seen; issue 39).
+void split_into(const std::string& s, char sep, std::vector<std::string>& out) {
+  size_t n = 0, start = 0;
+  for (;;) {
+    size_t end = s.find(sep, start);
+    if (end == std::string::npos) end = s.size();
+    if (n == out.size()) out.emplace_back();
+    std::string& cell = out[n++];
+    cell.assign(s, start, end - start);
+    if (cell.find('\r') != std::string::npos) cell.erase(std::remove(cell.begin(), cell.end(), '\r'), cell.end());
+    if (end == s.size()) break;
+    start = end + 1;
+  }
+  out.resize(n);
+}
+
 std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t\r\"");
   if (b == std::string::npos) return "";
@@ -296,11 +313,12 @@ Expected<TrajectoryFile> read_trajectory_csv(const std::string& path) {
   // The solution's own σ (pednav solution.csv / smoothed.csv): optional, empty cells = unknown.
   const int c_sd[3] = {find({"sd_e_m"}), find({"sd_n_m"}), find({"sd_d_m"})};
   int n = 1;
+  std::vector<std::string> cells;
   while (std::getline(in, line)) {
     ++n;
     ++f.lines;
     if (trim(line).empty()) continue;
-    const auto cells = split(line, ',');
+    split_into(line, ',', cells);
     auto cell = [&](int c) -> std::string { return c >= 0 && c < static_cast<int>(cells.size()) ? cells[c] : std::string(); };
     double week = 0, tow = 0;
     if (c_week >= 0 && c_tow >= 0) {

@@ -365,6 +365,46 @@ TEST(ErrorState, BlockDiscretizationEqualsGenericSeries) {
   }
 }
 
+// The row structure fusion/error_state_filter relies on (core/row_transition.hpp, issue 39): in Φ only the
+// position, velocity and attitude rows have off-diagonal entries; the bias, scale-factor and g-sensitivity rows (and
+// the blocks the INS model does not know) are scaled unit rows — random walks and Gauss-Markov states.
+TEST(ErrorState, OnlyNavigationRowsOfPhiHaveOffDiagonalEntries) {
+  ImuIncrement inc;
+  inc.dt_s = 0.05;
+  inc.t1 = inc.t0.plus_s(inc.dt_s);
+  inc.alpha_b = Eigen::Vector3d(0.05, 0.2, -0.03);
+  inc.dtheta_b = inc.alpha_b;
+  inc.upsilon_b = Eigen::Vector3d(0.15, -0.1, -0.49);
+  inc.dv_b = inc.upsilon_b;
+  inc.dp_b = 0.5 * inc.dt_s * inc.upsilon_b;
+  const InsState x = sample_state();
+  const NavState after = mechanize(x.nav, inc);
+  for (const bool g_sensitivity : {false, true}) {
+    for (const bool gauss_markov : {true, false}) {
+      const ErrorStateLayout l = g_sensitivity ? layout_with_g_sensitivity() : layout_with_scale();
+      ImuSpec sp = *imu_spec_preset("gx5_25");
+      sp.scale_tau_s = gauss_markov ? 1000.0 : 0.0;
+      sp.gyro_scale_sigma = 1e-3;
+      sp.accel_scale_sigma = 2e-3;
+      if (!gauss_markov) sp.gyro_bias_tau_s = sp.accel_bias_tau_s = 0.0;
+      DiscreteErrorModel m;
+      interval_error_model(l, sp, x.nav, after, inc, m);
+      const int n = l.dim();
+      int dense = 0;
+      for (int r = 0; r < n; ++r) {
+        int off = 0;
+        for (int c = 0; c < n; ++c) off += c != r && m.Phi(r, c) != 0.0 ? 1 : 0;
+        if (r < kBiasGyro.offset) {
+          dense += off > 0 ? 1 : 0;
+        } else {
+          EXPECT_EQ(off, 0) << "row " << r << " g-sensitivity " << g_sensitivity << " gm " << gauss_markov;
+        }
+      }
+      EXPECT_EQ(dense, 9);  // and the navigation rows do couple
+    }
+  }
+}
+
 TEST(ErrorState, SeriesQdAgreesWithVanLoanAt20Hz) {
   constexpr double kTolRel = 2e-3;  // Van Loan's O(Δt⁴) terms (attitude noise reaching v and p through [f×])
   const auto l = layout_with_scale();
