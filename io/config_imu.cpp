@@ -45,8 +45,10 @@ void read_columns(YamlMap& m, const char* key, std::array<int, 3>& out) {
 void read_imu_format(YamlMap& m, ImuFormat& out) {
   std::string delim(1, out.delimiter);
   m.text("delimiter", delim);
-  if (delim == "tab" || delim == "\\t") delim = "\t";
-  if (delim.size() != 1) {
+  // (No `delim = "\t"`: GCC 12 reports a false -Wrestrict on that assignment once the function is inlined.)
+  if (delim == "tab" || delim == "\\t") {
+    out.delimiter = '\t';
+  } else if (delim.size() != 1) {
     m.problem("delimiter", "expected one character (or 'tab'), got '" + delim + "'");
   } else {
     out.delimiter = delim[0];
