@@ -309,11 +309,8 @@ TEST(ErrorState, DiscretePhiWithGSensitivityMatchesNonlinearPropagation) {
   expect_phi_matches_nonlinear_foot_second(l, dx0, 6.147e-3);  // measured 2026-12-05 (ε = ½)
 }
 
-// The per-step path builds Φ and Q_d from 3x3 blocks (ins::interval_error_model with an output argument); it must
-// equal the generic n x n discretization of continuous_error_model at the interval mid-point, with and without the
-// optional scale blocks, with Gauss-Markov and random-walk biases, and leave foreign blocks (clock) untouched.
-TEST(ErrorState, BlockDiscretizationEqualsGenericSeries) {
-  constexpr double kTolRel = 1e-12;  // the same sums in another order
+// A 50-ms interval of a turning, accelerating foot (first-order increments).
+ImuIncrement sample_increment() {
   ImuIncrement inc;
   inc.dt_s = 0.05;
   inc.t1 = inc.t0.plus_s(inc.dt_s);
@@ -322,6 +319,15 @@ TEST(ErrorState, BlockDiscretizationEqualsGenericSeries) {
   inc.upsilon_b = Eigen::Vector3d(0.15, -0.1, -0.49);
   inc.dv_b = inc.upsilon_b;
   inc.dp_b = 0.5 * inc.dt_s * inc.upsilon_b;
+  return inc;
+}
+
+// The per-step path builds Φ and Q_d from 3x3 blocks (ins::interval_error_model with an output argument); it must
+// equal the generic n x n discretization of continuous_error_model at the interval mid-point, with and without the
+// optional scale blocks, with Gauss-Markov and random-walk biases, and leave foreign blocks (clock) untouched.
+TEST(ErrorState, BlockDiscretizationEqualsGenericSeries) {
+  constexpr double kTolRel = 1e-12;  // the same sums in another order
+  const ImuIncrement inc = sample_increment();
   const InsState x = sample_state();
   const NavState after = mechanize(x.nav, inc);
   for (const int blocks : {0, 1, 2}) {  // none, scale factors, scale factors + g-sensitivity
@@ -369,14 +375,7 @@ TEST(ErrorState, BlockDiscretizationEqualsGenericSeries) {
 // position, velocity and attitude rows have off-diagonal entries; the bias, scale-factor and g-sensitivity rows (and
 // the blocks the INS model does not know) are scaled unit rows — random walks and Gauss-Markov states.
 TEST(ErrorState, OnlyNavigationRowsOfPhiHaveOffDiagonalEntries) {
-  ImuIncrement inc;
-  inc.dt_s = 0.05;
-  inc.t1 = inc.t0.plus_s(inc.dt_s);
-  inc.alpha_b = Eigen::Vector3d(0.05, 0.2, -0.03);
-  inc.dtheta_b = inc.alpha_b;
-  inc.upsilon_b = Eigen::Vector3d(0.15, -0.1, -0.49);
-  inc.dv_b = inc.upsilon_b;
-  inc.dp_b = 0.5 * inc.dt_s * inc.upsilon_b;
+  const ImuIncrement inc = sample_increment();
   const InsState x = sample_state();
   const NavState after = mechanize(x.nav, inc);
   for (const bool g_sensitivity : {false, true}) {
