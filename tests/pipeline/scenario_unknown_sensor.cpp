@@ -11,10 +11,12 @@
 #include "core/geodesy.hpp"
 #include "core/rotation.hpp"
 #include "io/config.hpp"
+#include "io/imu_csv.hpp"
 #include "io/scenario_config.hpp"
 #include "pipeline/calibrate_command.hpp"
 #include "pipeline/compare_command.hpp"
 #include "pipeline/run_command.hpp"
+#include "pipeline/self_calibration.hpp"
 #include "pipeline/simulate_command.hpp"
 #include "sim/simulator.hpp"
 #include "tests/sim/fixtures.hpp"
@@ -82,6 +84,21 @@ TEST(UnknownSensor, CalibrateRecoversTheSensorAndAutoClosesTheLoop) {
               c.accel_noise_density(1) * 60.0, c.accel_noise_density(2) * 60.0);
   cfg->imu.spec_auto = true;
   cfg->zupt.shoe_threshold_auto = true;
+  // `zupt.shoe_threshold_motion` is the allowance above the rest level, and `auto` switches on the cross-validated
+  // gait-adaptive raise (ins::kAutoAdaptive*) unless it is configured.
+  {
+    auto log = io::read_imu_csv(cfg->imu.file, cfg->imu.format);
+    ASSERT_TRUE(log) << log.error().message;
+    io::RunConfig a = *cfg, b = *cfg;
+    b.zupt.shoe_threshold_motion = 4.0;
+    const auto sa = pipeline::resolve_self_calibration(a, *log), sb = pipeline::resolve_self_calibration(b, *log);
+    ASSERT_TRUE(sa && sb);
+    EXPECT_NEAR(sa->threshold.threshold - sa->threshold.rest, 2.5, 1e-12);
+    EXPECT_NEAR(sb->threshold.threshold - sa->threshold.threshold, 1.5, 1e-12);
+    EXPECT_DOUBLE_EQ(a.zupt.shoe_threshold, sa->threshold.threshold);
+    EXPECT_DOUBLE_EQ(a.zupt.shoe_adaptive_factor, ins::kAutoAdaptiveFactor);
+    EXPECT_NEAR(a.zupt.shoe_adaptive_min_peak_radps, ins::kAutoAdaptiveMinPeakDegPerS * kDegToRad, 1e-12);
+  }
   auto sum = pipeline::run_run_command(*cfg, dir + "/run");
   ASSERT_TRUE(sum) << sum.error().message;
   pipeline::CompareArgs args;
