@@ -104,6 +104,45 @@ class RowTransition {
     propagate<false>(P, static_cast<const MatP*>(nullptr), U);
   }
 
+  /// P_t ← Φ P_t Φᵀ (no process noise) for `count` symmetric n × n matrices stacked vertically in one column-major
+  /// array s0 (block t = rows [t n, (t + 1) n), leading dimension count · n): the errors-in-variables footprints
+  /// (docs/consistency.md §3.7). Each block gets exactly the arithmetic of propagate_symmetric(P_t, U), so the
+  /// results are bit-identical; the products the blocks share a Φ for (U = P Φ_Gᵀ, Z = Φ_G U) run once as passes
+  /// over count · n (count · dense_rows()) rows instead of count short ones. Scratch (not initialized): u of
+  /// count · n · dense_rows(), ut of count · dense_rows() · n, zt of count · dense_rows()² doubles.
+  void propagate_stacked(double* s0, int count, double* u0, double* ut, double* zt) const {
+    const int n = n_, m = n_dense_;
+    const Eigen::Index ld = static_cast<Eigen::Index>(count) * n, ldt = static_cast<Eigen::Index>(count) * m;
+    times_dense_rows_into(s0, ld, ld, u0, ld);  // U = S Φ_Gᵀ, all blocks at once
+    int k = 0;
+    for (int j = 0; j < n; ++j) {  // unit and scaled-unit columns: P_t(:, j) ← d_j d ∘ P_t(:, j)
+      if (k < m && dense_[k] == j) {
+        ++k;
+        continue;
+      }
+      if (!all_unit_) {
+        for (int t = 0; t < count; ++t) kernels::scale_by_outer(n, d_[j], d_.data(), s0 + j * ld + t * n);
+      }
+    }
+    // Uᵀ of every block, stacked: ut((t m + kk), i) = U_t(i, kk); then Zᵀ = Φ_G-sums of its columns, all blocks.
+    for (int i = 0; i < n; ++i) {
+      for (int t = 0; t < count; ++t) {
+        for (int kk = 0; kk < m; ++kk) ut[t * m + kk + i * ldt] = u0[t * n + i + kk * ld];
+      }
+    }
+    times_dense_rows_into(ut, ldt, ldt, zt, ldt);  // zt(t m + kk, l) = Z_t(l, kk)
+    for (int t = 0; t < count; ++t) {  // dense columns, then mirrored into their rows (as in propagate)
+      double* const pt = s0 + t * n;
+      for (k = 0; k < m; ++k) {
+        const int j = dense_[k];
+        double* const pj = pt + j * ld;
+        kernels::multiply(n, d_.data(), u0 + t * n + k * ld, pj);
+        for (int l = 0; l <= k; ++l) pj[dense_[l]] = zt[t * m + k + l * ldt];
+        for (int i = 0; i < n; ++i) pt[j + i * ld] = pj[i];
+      }
+    }
+  }
+
   /// A ← A Φᵀ (A: any number of rows × n; the smoother's cross-covariance Γ, docs/fusion.md eq. 12.15). U: scratch of
   /// at least A.rows() × dense_rows(). Unit columns are not touched, scaled-unit columns scaled.
   template <typename MatA, typename MatU>

@@ -97,7 +97,7 @@ ErrorStateFilter::ErrorStateFilter(const EngineOptions& o, int n_clocks) : o_(o)
       if (!b) continue;
       const bool gyro = std::string(name) == ins::kScaleGyroBlock;
       for (int axis = 0; axis < 3; ++axis) {
-        eiv_.push_back(EivTerm{b->offset + axis, gyro ? ins::kAtt.offset : ins::kVel.offset, axis, gyro, {}});
+        eiv_.push_back(EivTerm{b->offset + axis, gyro ? ins::kAtt.offset : ins::kVel.offset, axis, gyro});
       }
     }
   }
@@ -131,7 +131,7 @@ void ErrorStateFilter::init(const ins::NavState& nav, const ins::ImuErrors& imu,
   // the clocks and multipath states the GNSS updates also correlate them with (docs/consistency.md §3.7: the
   // subtracted totals change by < 2 % on the large ones, 5 % on the smallest, at about half the cost).
   eiv_dim_ = clock_blocks_.empty() ? layout_.dim() : clock_blocks_.front().offset;
-  for (auto& t : eiv_) t.M.setZero(eiv_dim_, eiv_dim_);  // no noise footprint yet (also at a re-init)
+  eiv_stack_.reset(eiv_dim_, static_cast<int>(eiv_.size()));  // no noise footprint yet (also at a re-init)
   interval_.restart(P_);  // sized; the smoother's bookkeeping starts at the first output epoch (smoother_restart)
   // With consider states the smoother runs on the Kalman-gain filter of the same linearization (docs/fusion.md
   // §12.6): its covariance starts as the filter's, its conditional mean of the error at zero. It has its own
@@ -143,7 +143,7 @@ void ErrorStateFilter::init(const ins::NavState& nav, const ins::ImuErrors& imu,
     Po_ = P_;
     eta_.setZero(P_.rows());
     eivo_ = eiv_;
-    for (auto& t : eivo_) t.M.setZero(layout_.dim(), layout_.dim());
+    eivo_stack_.reset(layout_.dim(), static_cast<int>(eivo_.size()));
   }
 }
 
@@ -200,8 +200,8 @@ void ErrorStateFilter::predict(const ins::ImuIncrement& inc) {
   // Smoother: the cross-covariance of the error at the last output epoch with the current error, Γ ← Γ Φᵀ
   // (docs/fusion.md eq. 12.15).
   if (recording_) interval_.predict(Phi_rows_);
-  if (!eiv_.empty()) eiv_predict(inc.dt_s, x_.nav, after, eiv_, P_);
-  if (shadow_ && !eivo_.empty()) eiv_predict(inc.dt_s, x_.nav, after, eivo_, Po_);
+  if (!eiv_.empty()) eiv_predict(inc.dt_s, x_.nav, after, eiv_, eiv_stack_, P_);
+  if (shadow_ && !eivo_.empty()) eiv_predict(inc.dt_s, x_.nav, after, eivo_, eivo_stack_, Po_);
   if (shadow_) {  // the Kalman-gain filter of the smoother (docs/fusion.md eq. 12.22): η ← Φ η, P_o ← Φ P_o Φᵀ + Q_d
     Phi_rows_.times_in_place(eta_, eta_tmp_);
     covariance_predict(Po_, Phi_rows_, m.Qd, tmp_);
@@ -377,21 +377,23 @@ double ErrorStateFilter::eiv_correction(int state) const {
 }
 
 void ErrorStateFilter::eiv_predict(double dt, const ins::NavState& before, const ins::NavState& after, std::vector<EivTerm>& terms,
-                 const ErrorMatrix& P) {
-  const int n = terms.empty() ? 0 : static_cast<int>(terms.front().M.rows());
+                 EivStack& stack, const ErrorMatrix& P) {
+  const int n = terms.empty() ? 0 : stack.n;
   if (n != layout_.dim()) eiv_Phi_.assign(model_.Phi.topLeftCorner(n, n), dense_rows_, n_dense_rows_ins_);
   const auto& Phi = n != layout_.dim() ? eiv_Phi_ : Phi_rows_;
   const Eigen::Matrix3d R = before.q_e_b.slerp(0.5, after.q_e_b).toRotationMatrix();
+  // Φ M Φᵀ for every footprint (no process noise of its own).
+  Phi.propagate_stacked(stack.s.data(), stack.count, stack.u.data(), stack.ut.data(), stack.zt.data());
   // The noise ν_u of every scale term u's regressor enters P's column of scale state t through P_tu (its own column
   // of Φ times P_{s_u s_t}), and the error through g_u: M_t gains Σ_u P_tu σ_u² Δt g_u g_uᵀ (docs/consistency.md
-  // eq. E.5; only u = t in session 9).
-  for (auto& t : terms) {
-    Phi.propagate_symmetric(t.M, eiv_tmp_);  // Φ M Φᵀ: no process noise of its own
+  // eq. E.5).
+  for (size_t ti = 0; ti < terms.size(); ++ti) {
+    const EivTerm& t = terms[ti];
+    auto M = stack.block(static_cast<int>(ti));
     for (const auto& u : terms) {
       const double psd = u.gyro ? spec_.gyro_arw * spec_.gyro_arw : spec_.accel_vrw * spec_.accel_vrw;
       const Vector3d g = R.col(u.axis);
-      t.M.block<3, 3>(u.block_offset, u.block_offset).noalias() +=
-          (P(t.state, u.state) * psd * dt) * (g * g.transpose());
+      M.block<3, 3>(u.block_offset, u.block_offset).noalias() += (P(t.state, u.state) * psd * dt) * (g * g.transpose());
     }
   }
 }

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -68,7 +69,7 @@ class ErrorStateFilter {
     double eiv_bias[kMaxEivTerms];
     const bool ok = joseph_update(P_, H, r, R, dx, [&](const auto& S_ldlt, const auto& K) {
       if (recording_ && !shadow_) interval_.update(H, r, S_ldlt, K);
-      eiv_update_all(eiv_, H, S_ldlt, K, eiv_bias);
+      eiv_update_all(eiv_, eiv_stack_, H, S_ldlt, K, eiv_bias);
     }, consider_);
     if (!ok) return false;
     if (shadow_) {
@@ -82,7 +83,7 @@ class ErrorStateFilter {
       double eivo_bias[kMaxEivTerms];
       if (joseph_update(Po_, H, nu, R, dxo, [&](const auto& So_ldlt, const auto& Ko) {
             if (recording_) interval_.update(H, nu, So_ldlt, Ko);
-            eiv_update_all(eivo_, H, So_ldlt, Ko, eivo_bias);
+            eiv_update_all(eivo_, eivo_stack_, H, So_ldlt, Ko, eivo_bias);
           })) {
         eiv_subtract(eivo_, eivo_bias, dxo, recording_, Po_);
         eta_ += dxo;
@@ -193,29 +194,82 @@ class ErrorStateFilter {
     int block_offset;  // error block the sensor noise enters: attitude (gyro) or velocity (accelerometer)
     int axis;          // body axis
     bool gyro;
-    ErrorMatrix M;
     double total = 0.0;
+  };
+  // The footprints M_t of all terms, stacked: block t is rows [t n, (t + 1) n) of one column-major (count n) × n
+  // array (leading dimension count · n), so the products that share Φ or H (M Φ_Gᵀ, Φ_G U, M Hᵀ) run once over all
+  // blocks (RowTransition::propagate_stacked); every block gets the arithmetic it had as a matrix of its own.
+  struct EivStack {
+    int n = 0, count = 0;
+    std::vector<double> s, u, ut, zt;  // footprints; scratch
+    // Sized once (no allocation when a re-initialization keeps the size); u holds M Hᵀ of up to
+    // kEivScratchRows measurement rows.
+    static constexpr int kEivScratchRows = 64;
+    void reset(int dim, int terms) {
+      n = dim;
+      count = terms;
+      const size_t nn = static_cast<size_t>(terms) * dim * dim;
+      s.assign(nn, 0.0);
+      u.resize(static_cast<size_t>(terms) * dim * std::max(dim, kEivScratchRows));
+      ut.resize(nn);
+      zt.resize(nn);
+    }
+    Eigen::Index ld() const { return static_cast<Eigen::Index>(count) * n; }
+    Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> block(int t) {
+      return {s.data() + static_cast<Eigen::Index>(t) * n, n, n, Eigen::OuterStride<>(ld())};
+    }
   };
   std::vector<EivTerm> eiv_;
   std::vector<EivTerm> eivo_;  // the same for the smoother's Kalman-gain filter (consider states, docs/fusion.md §12.6)
-  ErrorMatrix eiv_tmp_;
+  EivStack eiv_stack_, eivo_stack_;
   int eiv_dim_ = 0;
   RowTransition<ins::kMaxErrorDim> eiv_Phi_;  // the INS block of Φ (footprints over the INS states only)
 
   void eiv_predict(double dt, const ins::NavState& before, const ins::NavState& after, std::vector<EivTerm>& terms,
-                   const ErrorMatrix& P);
+                   EivStack& stack, const ErrorMatrix& P);
 
-  // eiv_update for every term of `terms` (the forward filter's or the smoother's Kalman-gain filter's) into bias[].
+  // The mean noise-noise part of K_s r for every term (the forward filter's or the smoother's Kalman-gain filter's),
+  // tr(S⁻¹ H M_t Hᵀ), into bias[], and M_t ← (I − K H) M_t (I − K H)ᵀ. H of a ZUPT or GNSS epoch touches a few states
+  // only: U = M Hᵀ is summed over H's non-zero columns for all blocks at once (columns of the stack through
+  // core/vector_kernels), B = H U per block; S⁻¹ (symmetric) is formed once.
   template <typename MatH, typename Ldlt, typename MatK>
-  void eiv_update_all(std::vector<EivTerm>& terms, const MatH& H, const Ldlt& S_ldlt, const MatK& K, double* bias) {
+  void eiv_update_all(std::vector<EivTerm>& terms, EivStack& st, const MatH& H, const Ldlt& S_ldlt, const MatK& K,
+                      double* bias) {
     if (terms.empty()) return;
+    const int ne = st.n, m = static_cast<int>(H.rows());
+    if (ne > H.cols()) {
+      for (size_t j = 0; j < terms.size(); ++j) bias[j] = 0.0;
+      return;
+    }
     int nz[ins::kMaxErrorDim];
     const int n_nz = nonzero_columns(H, nz);
     using SMat = Eigen::Matrix<double, MatH::RowsAtCompileTime, MatH::RowsAtCompileTime, Eigen::ColMajor,
                                MatH::MaxRowsAtCompileTime, MatH::MaxRowsAtCompileTime>;
+    using UMat = Eigen::Matrix<double, Eigen::Dynamic, MatH::RowsAtCompileTime, Eigen::ColMajor, ins::kMaxErrorDim,
+                               MatH::MaxRowsAtCompileTime>;
     SMat S_inv = SMat::Identity(H.rows(), H.rows());
     S_ldlt.solveInPlace(S_inv);  // once per update, shared by the terms
-    for (size_t j = 0; j < terms.size(); ++j) bias[j] = eiv_update(terms[j].M, H, nz, n_nz, S_inv, K);
+    const Eigen::Index ld = st.ld();
+    if (st.u.size() < static_cast<size_t>(ld * m)) st.u.resize(static_cast<size_t>(ld * m));  // > 64 rows only
+    double* const u_all = st.u.data();
+    std::fill(u_all, u_all + ld * m, 0.0);
+    for (int i = 0; i < m; ++i) {  // M Hᵀ of every block
+      for (int k = 0; k < n_nz && nz[k] < ne; ++k) {
+        const double h = H(i, nz[k]);
+        if (h != 0.0) kernels::axpy1(ld, h, st.s.data() + nz[k] * ld, u_all + i * ld);
+      }
+    }
+    UMat U(ne, m);
+    SMat B;
+    for (int t = 0; t < st.count; ++t) {
+      for (int i = 0; i < m; ++i) U.col(i) = Eigen::Map<const Eigen::VectorXd>(u_all + i * ld + t * ne, ne);
+      B.setZero(m, m);  // H M Hᵀ = H U
+      for (int k = 0; k < n_nz && nz[k] < ne; ++k) B.noalias() += H.col(nz[k]) * U.row(nz[k]);
+      bias[t] = S_inv.cwiseProduct(B).sum();  // tr(S⁻¹ B) with S⁻¹ and B symmetric
+      // (I − K H) M (I − K H)ᵀ on the footprint's states: the noise-free form (R = 0) of the Joseph update.
+      auto M = st.block(t);
+      gain_downdate(M, U, K.topRows(ne), B);
+    }
   }
   // Subtract the mean noise parts from the correction dx (docs/consistency.md eq. E.4) and, with shift_interval,
   // remove the same bias from the smoother interval's mean: in every component by regression on the scale states
@@ -225,34 +279,6 @@ class ErrorStateFilter {
   void eiv_subtract(std::vector<EivTerm>& terms, const double* bias, ErrorVector& dx, bool shift_interval,
                     const ErrorMatrix& P);
 
-  // The mean noise-noise part of K_s r for one scale state, tr(S⁻¹ H M Hᵀ), and M ← (I − K H) M (I − K H)ᵀ. H of a
-  // ZUPT or GNSS epoch touches a few states only: U = M Hᵀ and B = H U are summed over H's non-zero columns
-  // nz[0..n_nz) (columns of M through core/vector_kernels, no small-GEMM set-up); S_inv = S⁻¹ (symmetric).
-  template <typename MatH, typename MatSinv, typename MatK>
-  double eiv_update(ErrorMatrix& M, const MatH& H, const int* nz, int n_nz, const MatSinv& S_inv, const MatK& K) {
-    const int ne = static_cast<int>(M.rows());
-    if (ne > H.cols()) return 0.0;
-    using UMat = Eigen::Matrix<double, Eigen::Dynamic, MatH::RowsAtCompileTime, Eigen::ColMajor, ins::kMaxErrorDim,
-                               MatH::MaxRowsAtCompileTime>;
-    using SMat = Eigen::Matrix<double, MatH::RowsAtCompileTime, MatH::RowsAtCompileTime, Eigen::ColMajor,
-                               MatH::MaxRowsAtCompileTime, MatH::MaxRowsAtCompileTime>;
-    const int m = static_cast<int>(H.rows());
-    UMat U;  // M Hᵀ
-    U.setZero(ne, m);
-    for (int i = 0; i < m; ++i) {
-      for (int k = 0; k < n_nz && nz[k] < ne; ++k) {
-        const double h = H(i, nz[k]);
-        if (h != 0.0) kernels::axpy1(ne, h, M.col(nz[k]).data(), U.col(i).data());
-      }
-    }
-    SMat B;  // H M Hᵀ = H U
-    B.setZero(m, m);
-    for (int k = 0; k < n_nz && nz[k] < ne; ++k) B.noalias() += H.col(nz[k]) * U.row(nz[k]);
-    const double bias = S_inv.cwiseProduct(B).sum();  // tr(S⁻¹ B) with S⁻¹ and B symmetric
-    // (I − K H) M (I − K H)ᵀ on the INS block: the noise-free form (R = 0) of the Joseph update.
-    gain_downdate(M, U, K.topRows(ne), B);
-    return bias;
-  }
   // Smoother: the interval since the last output epoch (docs/fusion.md eqs. 12.14-12.20), kept from the first
   // output epoch on.
   bool recording_ = false;

@@ -58,9 +58,13 @@ SaturationRepair repair_saturation(const std::vector<ImuSample>& samples, const 
     const double r = gyro ? o.gyro_range_radps : o.accel_range_mps2;
     if (!(r > 0.0) || n == 0) continue;
     long above = 0;
+    double max_abs = 0.0;  // largest finite |value| on any axis: below the clip level, no run to look for
     for (const auto& s : samples) {
       const Eigen::Vector3d& x = gyro ? s.omega_ib_b : s.f_ib_b;
       if (x.allFinite() && x.cwiseAbs().maxCoeff() > 1.01 * r) ++above;
+      for (int a = 0; a < 3; ++a) {
+        if (std::isfinite(x(a))) max_abs = std::max(max_abs, std::abs(x(a)));
+      }
     }
     if (above > 0) {
       char buf[200];
@@ -72,6 +76,7 @@ SaturationRepair repair_saturation(const std::vector<ImuSample>& samples, const 
       continue;
     }
     const double lim = o.level * r;
+    if (max_abs < lim) continue;
     auto clipped = [&](size_t k, int axis) {
       const double v = value(samples[k], gyro, axis);
       return std::isfinite(v) && std::abs(v) >= lim;

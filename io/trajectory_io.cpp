@@ -10,6 +10,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <string_view>
 #include <vector>
 
 #include "core/geodesy.hpp"
@@ -32,23 +33,6 @@ std::vector<std::string> split(const std::string& s, char sep) {
   return out;
 }
 
-// The same into `out`, reused from line to line (its strings keep their capacity: no allocation per line once the
-// cells are as long as the longest seen; issue 39).
-void split_into(const std::string& s, char sep, std::vector<std::string>& out) {
-  size_t n = 0, start = 0;
-  for (;;) {
-    size_t end = s.find(sep, start);
-    if (end == std::string::npos) end = s.size();
-    if (n == out.size()) out.emplace_back();
-    std::string& cell = out[n++];
-    cell.assign(s, start, end - start);
-    if (cell.find('\r') != std::string::npos) cell.erase(std::remove(cell.begin(), cell.end(), '\r'), cell.end());
-    if (end == s.size()) break;
-    start = end + 1;
-  }
-  out.resize(n);
-}
-
 std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t\r\"");
   if (b == std::string::npos) return "";
@@ -56,12 +40,32 @@ std::string trim(const std::string& s) {
   return s.substr(b, e - b + 1);
 }
 
-bool to_double(const std::string& s, double& v) {
-  const std::string t = trim(s);
+std::string_view trim_view(std::string_view s) {
+  const auto b = s.find_first_not_of(" \t\r\"");
+  if (b == std::string_view::npos) return {};
+  const auto e = s.find_last_not_of(" \t\r\"");
+  return s.substr(b, e - b + 1);
+}
+
+bool to_double(std::string_view s, double& v) {
+  const std::string_view t = trim_view(s);
   if (t.empty()) return false;
   const char* end = t.data() + t.size();
   auto [p, ec] = std::from_chars(t.data(), end, v);
   return ec == std::errc() && p == end && std::isfinite(v);
+}
+
+// The cells of one line as views into it (no copy; valid while the line is), reused from line to line.
+void split_views(std::string_view s, char sep, std::vector<std::string_view>& out) {
+  out.clear();
+  size_t start = 0;
+  for (;;) {
+    size_t end = s.find(sep, start);
+    if (end == std::string_view::npos) end = s.size();
+    out.push_back(s.substr(start, end - start));
+    if (end == s.size()) break;
+    start = end + 1;
+  }
 }
 
 // Append a point, dropping repeated times (counted) and rejecting backwards time with file:line.
@@ -313,13 +317,15 @@ Expected<TrajectoryFile> read_trajectory_csv(const std::string& path) {
   // The solution's own σ (pednav solution.csv / smoothed.csv): optional, empty cells = unknown.
   const int c_sd[3] = {find({"sd_e_m"}), find({"sd_n_m"}), find({"sd_d_m"})};
   int n = 1;
-  std::vector<std::string> cells;
+  std::vector<std::string_view> cells;
   while (std::getline(in, line)) {
     ++n;
     ++f.lines;
-    if (trim(line).empty()) continue;
-    split_into(line, ',', cells);
-    auto cell = [&](int c) -> std::string { return c >= 0 && c < static_cast<int>(cells.size()) ? cells[c] : std::string(); };
+    if (trim_view(line).empty()) continue;
+    split_views(line, ',', cells);
+    auto cell = [&](int c) -> std::string_view {
+      return c >= 0 && c < static_cast<int>(cells.size()) ? cells[c] : std::string_view();
+    };
     double week = 0, tow = 0;
     if (c_week >= 0 && c_tow >= 0) {
       if (!to_double(cell(c_week), week) || !to_double(cell(c_tow), tow)) {
@@ -339,7 +345,7 @@ Expected<TrajectoryFile> read_trajectory_csv(const std::string& path) {
     bool ok = true;
     int empty = 0;
     for (int j = 0; j < 3; ++j) {
-      if (trim(cell(pc[j])).empty()) ++empty;
+      if (trim_view(cell(pc[j])).empty()) ++empty;
       else ok = ok && to_double(cell(pc[j]), v[j]);
     }
     if (empty == 3) {
@@ -353,7 +359,7 @@ Expected<TrajectoryFile> read_trajectory_csv(const std::string& path) {
     Eigen::Vector3d sd = Eigen::Vector3d::Constant(std::nan(""));
     for (int j = 0; j < 3; ++j) {
       double x = 0.0;
-      if (c_sd[j] >= 0 && !trim(cell(c_sd[j])).empty() && to_double(cell(c_sd[j]), x) && std::isfinite(x) && x >= 0.0) sd(j) = x;
+      if (c_sd[j] >= 0 && !trim_view(cell(c_sd[j])).empty() && to_double(cell(c_sd[j]), x) && std::isfinite(x) && x >= 0.0) sd(j) = x;
     }
     if (auto r = push_point(f, path, n, GpsTime::from_week_tow(static_cast<int>(week), tow), p, sd); !r) return r.error();
   }

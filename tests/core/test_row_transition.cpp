@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <vector>
 
 #include "core/row_transition.hpp"
 
@@ -87,6 +88,39 @@ TEST_P(RowTransitionSizes, ProductsEqualTheDenseOnesAndPStaysSymmetric) {
   T.times_in_place(x, tmp);
   EXPECT_LT((Eigen::VectorXd(x) - expected_x).cwiseAbs().maxCoeff(),
             kTolRel * expected_x.cwiseAbs().maxCoeff() + 1e-15);
+}
+
+// The stacked form (the six errors-in-variables footprints of the filter, fusion/error_state_filter.hpp) gives every
+// block exactly — bit for bit — what propagate_symmetric gives it alone, for 1 to 6 blocks; the blocks differ, and a
+// scaled-unit row (all_unit_ false) and a zero row are in Φ.
+TEST_P(RowTransitionSizes, StackedBlocksEqualSeparatePropagationBitForBit) {
+  const int n = GetParam();
+  std::mt19937 rng(31u + static_cast<unsigned>(n));
+  const Mat Phi = structured(n, 41u + static_cast<unsigned>(n));
+  RowTransition<48> T;
+  T.assign(Phi);
+  const int m = T.dense_rows();
+  for (int count : {1, 2, 6}) {
+    std::vector<Mat> blocks;
+    for (int t = 0; t < count; ++t) blocks.push_back(random_spd(n, rng));
+    const Eigen::Index ld = static_cast<Eigen::Index>(count) * n;
+    std::vector<double> s(static_cast<size_t>(ld * n)), u(static_cast<size_t>(ld * std::max(m, 1))),
+        ut(static_cast<size_t>(count * std::max(m, 1) * n)), zt(static_cast<size_t>(count * std::max(m * m, 1)));
+    for (int t = 0; t < count; ++t)
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) s[static_cast<size_t>(t * n + i + j * ld)] = blocks[t](i, j);
+    T.propagate_stacked(s.data(), count, u.data(), ut.data(), zt.data());
+    Mat U;
+    for (int t = 0; t < count; ++t) {
+      Mat expected = blocks[t];
+      T.propagate_symmetric(expected, U);
+      double worst = 0.0;
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i)
+          worst = std::max(worst, std::abs(s[static_cast<size_t>(t * n + i + j * ld)] - expected(i, j)));
+      EXPECT_EQ(worst, 0.0) << "n " << n << " count " << count << " block " << t;
+    }
+  }
 }
 
 TEST(RowTransition, IdentityLeavesPAndAddsQ) {
