@@ -326,7 +326,49 @@ AutoThreshold auto_shoe_threshold(const std::vector<double>& t, const ImuCalibra
   a.from_still = !at_rest.empty();
   a.rest = a.from_still ? percentile(at_rest, o.rest_quantile) : percentile(t, 0.05);
   a.threshold = a.rest + o.motion;
+  a.cap = o.two_class_cap;
+  if (o.two_class_cap > 0.0) {  // docs/zupt.md eq. 6.2
+    a.split = two_class_split(t);
+    const double capped = std::min(a.split, o.two_class_cap);
+    if (capped > a.threshold) {
+      a.threshold = capped;
+      a.from_split = true;
+    }
+  }
   return a;
+}
+
+double two_class_split(const std::vector<double>& t, int bins) {
+  if (t.empty() || bins < 2) return 0.0;
+  std::vector<double> lt(t.size());
+  double lo = 1e300, hi = -1e300;
+  for (size_t i = 0; i < t.size(); ++i) {
+    lt[i] = std::log10(std::max(t[i], 1e-6));
+    lo = std::min(lo, lt[i]);
+    hi = std::max(hi, lt[i]);
+  }
+  if (!(hi > lo)) return 0.0;
+  std::vector<double> h(static_cast<size_t>(bins), 0.0);
+  const double w = (hi - lo) / bins;
+  for (double v : lt) h[static_cast<size_t>(std::min(bins - 1, static_cast<int>((v - lo) / w)))] += 1.0;
+  // Between-class variance of the bin index for a split after bin i: w_b w_f (μ_b − μ_f)² (up to a constant).
+  const double n = static_cast<double>(lt.size());
+  double total = 0.0;
+  for (int i = 0; i < bins; ++i) total += i * h[static_cast<size_t>(i)];
+  double wb = 0.0, sb = 0.0, best = -1.0;
+  int best_i = 0;
+  for (int i = 0; i < bins; ++i) {
+    wb += h[static_cast<size_t>(i)];
+    if (wb == 0.0 || wb == n) continue;
+    sb += i * h[static_cast<size_t>(i)];
+    const double mb = sb / wb, mf = (total - sb) / (n - wb);
+    const double var = wb * (n - wb) * (mb - mf) * (mb - mf);
+    if (var > best) {
+      best = var;
+      best_i = i;
+    }
+  }
+  return std::pow(10.0, lo + (best_i + 1) * w);
 }
 
 }  // namespace pednav::ins

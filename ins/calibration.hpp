@@ -130,7 +130,17 @@ struct AutoThresholdOptions {
   /// Chosen with kAutoAdaptiveFactor and kAutoAdaptiveMinPeakDegPerS by leave-one-session-out cross-validation on
   /// the 24 PyShoe trials (scripts/pyshoe_loso; docs/zupt.md §6, docs/results.md "Out of the box").
   double motion = 2.5;
+  /// The two-class split (docs/zupt.md eq. 6.2): γ is raised to the boundary that best separates the log's
+  /// statistic into two classes (Otsu on log10 T), at most to this cap; 0 = off (γ = rest + motion). The split is
+  /// where a gait's stance and swing part; on slow, rolling or crawling motion it lies far above rest + motion and
+  /// recovers the stances the fixed allowance misses. Chosen by leave-one-session-out cross-validation with the
+  /// other auto knobs (scripts/pyshoe_loso).
+  double two_class_cap = 10.0;
 };
+/// The boundary between the two classes of a positive statistic (T, e.g. SHOE) that maximizes the between-class
+/// variance of log10 T (Otsu 1979) over a histogram of `bins` equal bins between the smallest and largest log10 T
+/// (T clamped at 1e-6); 0 when the statistic has fewer than two distinct values.
+double two_class_split(const std::vector<double>& statistic, int bins = 200);
 /// The gait-adaptive raise (docs/zupt.md §1) that `zupt.shoe_threshold: auto` switches on unless its keys are given:
 /// threshold max(γ, factor × the smallest T within ±window/2) next to a swing whose peak rate reaches the minimum.
 inline constexpr double kAutoAdaptiveFactor = 4.0;
@@ -138,8 +148,11 @@ inline constexpr double kAutoAdaptiveWindowS = 1.0;
 inline constexpr double kAutoAdaptiveMinPeakDegPerS = 360.0;
 struct AutoThreshold {
   double rest = 0.0;       ///< T at rest (the rest_quantile over the still periods)
-  double threshold = 0.0;  ///< γ
+  double threshold = 0.0;  ///< γ = max(rest + motion, min(split, cap))
   bool from_still = false; ///< rest level from still periods (else the 5th percentile of T)
+  double split = 0.0;      ///< two_class_split of the whole log's T (0: not used)
+  bool from_split = false; ///< γ is the (capped) split, above rest + motion
+  double cap = 0.0;        ///< the cap the split was held to (AutoThresholdOptions::two_class_cap; 0: off)
 };
 AutoThreshold auto_shoe_threshold(const std::vector<double>& shoe_statistic, const ImuCalibration& calibration,
                                   const AutoThresholdOptions& options = {});

@@ -88,6 +88,9 @@ struct ZuptConfig {
   /// key shoe_threshold_motion: with shoe_threshold: auto, γ = the statistic at rest + this allowance
   /// (ins::AutoThresholdOptions::motion; docs/zupt.md §6)
   double shoe_threshold_motion = ins::AutoThresholdOptions{}.motion;
+  /// key shoe_threshold_two_class_cap: with shoe_threshold: auto, γ is raised to the two-class split of the log's
+  /// statistic up to this cap; 0 = off (ins::AutoThresholdOptions::two_class_cap; docs/zupt.md eq. 6.2)
+  double shoe_threshold_two_class_cap = ins::AutoThresholdOptions{}.two_class_cap;
   bool edge_s_given = false;               ///< zupt.edge_s was in the file (else `auto` may choose it)
   bool zaru_gate_given = false;            ///< zupt.zaru_gate_probability was in the file
   bool zaru_sigma_given = false;           ///< zupt.zaru_sigma_deg_per_s was in the file

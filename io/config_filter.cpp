@@ -34,6 +34,10 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
     if (z.has("shoe_threshold_motion") && !c.shoe_threshold_auto) {
       z.problem("shoe_threshold_motion", "only used with shoe_threshold: auto");
     }
+    z.number("shoe_threshold_two_class_cap", c.shoe_threshold_two_class_cap, false, 0.0, 1e12);
+    if (z.has("shoe_threshold_two_class_cap") && !c.shoe_threshold_auto) {
+      z.problem("shoe_threshold_two_class_cap", "only used with shoe_threshold: auto");
+    }
     z.number("min_stance_s", c.min_stance_s, false, 0.0, 5.0);
     read_zupt_hmm_keys(z, c);
     z.number("sigma_mps", c.sigma_mps, false, 1e-6, 10.0);

@@ -56,11 +56,18 @@ std::string calibration_yaml(const SelfCalibration& s, const std::string& imu_fi
   y += fmt::format("    accel_range_g: {:.6g}                     # {}\n", p.accel_range / 9.80665,
                    c.accel_plateau_mps2 > 0.0 ? "the saturation plateau found" : "0 = unknown (no plateau found)");
   y += "zupt:\n";
-  y += fmt::format("  shoe_threshold: {:.6g}   # the SHOE statistic at rest ({:.4g}, {}) + the motion allowance {:.3g}, "
-                   "with the configured sigmas\n",
-                   s.threshold.threshold, s.threshold.rest,
-                   s.threshold.from_still ? "99th percentile over the still periods" : "5th percentile: no still period",
-                   s.threshold.threshold - s.threshold.rest);
+  if (s.threshold.from_split) {
+    y += fmt::format("  shoe_threshold: {:.6g}   # the two-class split of the log's SHOE statistic ({:.4g}, capped at "
+                     "{:.3g}; docs/zupt.md eq. 6.2), above the level at rest {:.4g} ({}) + the motion allowance\n",
+                     s.threshold.threshold, s.threshold.split, s.threshold.cap, s.threshold.rest,
+                     s.threshold.from_still ? "99th percentile over the still periods" : "5th percentile: no still period");
+  } else {
+    y += fmt::format("  shoe_threshold: {:.6g}   # the SHOE statistic at rest ({:.4g}, {}) + the motion allowance {:.3g}, "
+                     "with the configured sigmas (two-class split {:.4g} lower)\n",
+                     s.threshold.threshold, s.threshold.rest,
+                     s.threshold.from_still ? "99th percentile over the still periods" : "5th percentile: no still period",
+                     s.threshold.threshold - s.threshold.rest, s.threshold.split);
+  }
   y += fmt::format("  shoe_adaptive_factor: {:g}   # raised to {:g} x the local minimum next to a swing (docs/zupt.md §1)\n",
                    ins::kAutoAdaptiveFactor, ins::kAutoAdaptiveFactor);
   y += fmt::format("  shoe_adaptive_window_s: {:g}\n", ins::kAutoAdaptiveWindowS);

@@ -50,6 +50,7 @@ std::optional<SelfCalibration> resolve_self_calibration(io::RunConfig& c, const 
     const ins::ZuptDetectorOptions zo = io::zupt_detector_options(c.zupt);
     ins::AutoThresholdOptions ao;
     ao.motion = c.zupt.shoe_threshold_motion;
+    ao.two_class_cap = c.zupt.shoe_threshold_two_class_cap;
     s.threshold = ins::auto_shoe_threshold(ins::shoe_statistic(log.samples, zo), s.calibration, ao);
     c.zupt.shoe_threshold = s.threshold.threshold;
     c.zupt.shoe_threshold_auto = false;
@@ -128,7 +129,10 @@ nlohmann::ordered_json self_calibration_json(const SelfCalibration& s) {
   if (s.threshold_auto) {
     j["shoe_threshold"] = {{"rest", s.threshold.rest},
                            {"threshold", s.threshold.threshold},
-                           {"rest_from", s.threshold.from_still ? "still periods" : "5th percentile (no still period)"}};
+                           {"rest_from", s.threshold.from_still ? "still periods" : "5th percentile (no still period)"},
+                           {"two_class_split", s.threshold.split},
+                           {"two_class_cap", s.threshold.cap},
+                           {"from", s.threshold.from_split ? "two-class split (capped)" : "rest + motion allowance"}};
   }
   return j;
 }

@@ -174,6 +174,50 @@ TEST(Calibration, AutoThresholdIsTheRestLevelPlusTheMotionAllowance) {
   EXPECT_LT(b.rest, 0.011);  // the 5th percentile: still samples are 8 s of 30
 }
 
+TEST(Calibration, TwoClassSplitIsTheOtsuBoundaryOfLog10T) {
+  // Two values, half each: every split between them separates the classes equally well; the first (after bin 0 of
+  // 200 between log10 1 = 0 and log10 100 = 2) is taken: 10^0.01.
+  std::vector<double> t;
+  for (int i = 0; i < 50; ++i) {
+    t.push_back(1.0);
+    t.push_back(100.0);
+  }
+  EXPECT_NEAR(two_class_split(t), std::pow(10.0, 0.01), 1e-12);
+  EXPECT_EQ(two_class_split(std::vector<double>(10, 3.0)), 0.0);  // one value: no split
+  EXPECT_EQ(two_class_split({}), 0.0);
+  // Zero and negative values are clamped at 1e-6 (log10 = -6).
+  EXPECT_NEAR(two_class_split({0.0, 0.0, 1.0, 1.0}), std::pow(10.0, -6.0 + 6.0 / 200.0), 1e-15);
+}
+
+TEST(Calibration, AutoThresholdRisesToTheTwoClassSplitUpToTheCap) {
+  // A slow, rolling gait: rest 10 % at 0.01, stance 40 % at T = 5 (above rest + motion = 2.51), swing 50 % at 1e4.
+  // The split falls between stance and swing, so γ rises above 5 and the stance is found; the cap limits it.
+  Synthetic syn;
+  const auto s = syn.make();
+  const ImuCalibration c = calibrate_imu(s);
+  std::vector<double> t(s.size());
+  for (size_t i = 0; i < t.size(); ++i) t[i] = (i % 10 == 0) ? 0.01 : (i % 10 < 5 ? 5.0 : 1e4);
+  for (const auto& p : c.still) {
+    for (size_t i = p.begin; i < p.end; ++i) t[i] = 0.01;
+  }
+  AutoThresholdOptions o;
+  const AutoThreshold a = auto_shoe_threshold(t, c, o);
+  EXPECT_NEAR(a.rest, 0.01, 1e-12);
+  EXPECT_GT(a.split, 5.0);
+  EXPECT_LT(a.split, 6.0);  // the first bin boundary above log10 5 (bins of (4 + 2) / 200 = 0.03 decades)
+  EXPECT_TRUE(a.from_split);
+  EXPECT_DOUBLE_EQ(a.threshold, a.split);
+  EXPECT_DOUBLE_EQ(a.cap, 10.0);
+  o.two_class_cap = 3.0;
+  const AutoThreshold capped = auto_shoe_threshold(t, c, o);
+  EXPECT_DOUBLE_EQ(capped.threshold, 3.0);
+  EXPECT_TRUE(capped.from_split);
+  o.two_class_cap = 0.0;  // off: rest + motion
+  const AutoThreshold off = auto_shoe_threshold(t, c, o);
+  EXPECT_FALSE(off.from_split);
+  EXPECT_DOUBLE_EQ(off.threshold, 0.01 + o.motion);
+}
+
 TEST(Calibration, AutoSpecCoversTheMeasuredBiasAndKeepsTheNoiseFloors) {
   Synthetic syn;
   syn.gyro_sigma = 0.2;  // a noisy sensor: 0.2 rad/s per sample at 500 Hz = 32 deg/sqrt(h), above the floor

@@ -384,6 +384,17 @@ TEST(Config, AutoSpecAndAutoThresholdAreFlagsAndMisspellingsAreNamed) {
   auto fixed = parse(base + "zupt:\n  shoe_threshold: 3\n  shoe_threshold_motion: 2.5\n");
   ASSERT_FALSE(fixed);
   EXPECT_THAT(fixed.error().message, HasSubstr("zupt.shoe_threshold_motion: only used with shoe_threshold: auto"));
+  EXPECT_DOUBLE_EQ(cfg->zupt.shoe_threshold_two_class_cap, 10.0);  // ins::AutoThresholdOptions' cap
+  auto cap = parse(base + "zupt:\n  shoe_threshold: auto\n  shoe_threshold_two_class_cap: 0\n");
+  ASSERT_TRUE(cap) << cap.error().message;
+  EXPECT_DOUBLE_EQ(cap->zupt.shoe_threshold_two_class_cap, 0.0);
+  auto fixed_cap = parse(base + "zupt:\n  shoe_threshold: 3\n  shoe_threshold_two_class_cap: 5\n");
+  ASSERT_FALSE(fixed_cap);
+  EXPECT_THAT(fixed_cap.error().message,
+              HasSubstr("zupt.shoe_threshold_two_class_cap: only used with shoe_threshold: auto"));
+  auto negative_cap = parse(base + "zupt:\n  shoe_threshold: auto\n  shoe_threshold_two_class_cap: -1\n");
+  ASSERT_FALSE(negative_cap);
+  EXPECT_THAT(negative_cap.error().message, HasSubstr("zupt.shoe_threshold_two_class_cap"));
   auto bad = parse(base + "zupt:\n  shoe_threshold: automatic\n");
   ASSERT_FALSE(bad);
   EXPECT_THAT(bad.error().message, HasSubstr("zupt.shoe_threshold"));

@@ -5,6 +5,8 @@
 // must close the loop (docs/ins.md §10, docs/zupt.md §6).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cstdio>
 #include <filesystem>
 
@@ -32,7 +34,7 @@ namespace {
 // deterministic; the margin is for another libm), which the non-auto configuration does not meet.
 constexpr double kMaxClosurePct = 1.0;
 constexpr double kMaxRms_m = 0.55;
-constexpr double kMeasuredClosurePct = 0.31, kMeasuredDistance_m = 187.9;  // closure bound + 30 %, distance ±1 %
+constexpr double kMeasuredClosurePct = 0.33, kMeasuredDistance_m = 187.9;  // closure bound + 30 %, distance ±1 %
 // Calibration, measured 2026-12-05: ARW 18.30 / 18.02 / 17.61 deg/√h against the simulated 18, VRW 0.3537 / 0.3521 /
 // 0.3531 m/s/√h against 0.353; +z up, tilt 30.204°. Beside the issue's ±20 %: each axis within ±3 % of its measured
 // figure (an estimate from one seeded log: deterministic; 3 % lets the still-period windows move by one), the
@@ -89,12 +91,22 @@ TEST(UnknownSensor, CalibrateRecoversTheSensorAndAutoClosesTheLoop) {
   {
     auto log = io::read_imu_csv(cfg->imu.file, cfg->imu.format);
     ASSERT_TRUE(log) << log.error().message;
-    io::RunConfig a = *cfg, b = *cfg;
+    io::RunConfig a = *cfg, b = *cfg, c0 = *cfg;
     b.zupt.shoe_threshold_motion = 4.0;
-    const auto sa = pipeline::resolve_self_calibration(a, *log), sb = pipeline::resolve_self_calibration(b, *log);
-    ASSERT_TRUE(sa && sb);
-    EXPECT_NEAR(sa->threshold.threshold - sa->threshold.rest, 2.5, 1e-12);
-    EXPECT_NEAR(sb->threshold.threshold - sa->threshold.threshold, 1.5, 1e-12);
+    c0.zupt.shoe_threshold_two_class_cap = 0.0;
+    const auto sa = pipeline::resolve_self_calibration(a, *log), sb = pipeline::resolve_self_calibration(b, *log),
+               sc = pipeline::resolve_self_calibration(c0, *log);
+    ASSERT_TRUE(sa && sb && sc);
+    // This log's two-class split (measured: the level at rest + 3.01) lies above rest + 2.5 and below the cap 10:
+    // γ is the split (docs/zupt.md eq. 6.2); with an allowance of 4, rest + 4 is above the split; without the split
+    // (cap 0), rest + 2.5.
+    EXPECT_TRUE(sa->threshold.from_split);
+    EXPECT_DOUBLE_EQ(sa->threshold.threshold, std::min(sa->threshold.split, 10.0));
+    EXPECT_GT(sa->threshold.threshold, sa->threshold.rest + 2.5);
+    EXPECT_FALSE(sb->threshold.from_split);
+    EXPECT_NEAR(sb->threshold.threshold - sb->threshold.rest, 4.0, 1e-12);
+    EXPECT_FALSE(sc->threshold.from_split);
+    EXPECT_NEAR(sc->threshold.threshold - sc->threshold.rest, 2.5, 1e-12);
     EXPECT_DOUBLE_EQ(a.zupt.shoe_threshold, sa->threshold.threshold);
     EXPECT_DOUBLE_EQ(a.zupt.shoe_adaptive_factor, ins::kAutoAdaptiveFactor);
     EXPECT_NEAR(a.zupt.shoe_adaptive_min_peak_radps, ins::kAutoAdaptiveMinPeakDegPerS * kDegToRad, 1e-12);
