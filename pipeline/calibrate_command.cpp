@@ -62,11 +62,13 @@ std::string calibration_yaml(const SelfCalibration& s, const std::string& imu_fi
                      s.threshold.threshold, s.threshold.split, s.threshold.cap, s.threshold.rest,
                      s.threshold.from_still ? "99th percentile over the still periods" : "5th percentile: no still period");
   } else {
+    const std::string split = s.threshold.cap > 0.0 ? fmt::format("two-class split {:.4g} lower", s.threshold.split)
+                                                    : std::string("two-class split off");
     y += fmt::format("  shoe_threshold: {:.6g}   # the SHOE statistic at rest ({:.4g}, {}) + the motion allowance {:.3g}, "
-                     "with the configured sigmas (two-class split {:.4g} lower)\n",
+                     "with the configured sigmas ({})\n",
                      s.threshold.threshold, s.threshold.rest,
                      s.threshold.from_still ? "99th percentile over the still periods" : "5th percentile: no still period",
-                     s.threshold.threshold - s.threshold.rest, s.threshold.split);
+                     s.threshold.threshold - s.threshold.rest, split);
   }
   y += fmt::format("  shoe_adaptive_factor: {:g}   # raised to {:g} x the local minimum next to a swing (docs/zupt.md §1)\n",
                    ins::kAutoAdaptiveFactor, ins::kAutoAdaptiveFactor);
