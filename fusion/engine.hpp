@@ -191,6 +191,8 @@ struct EngineSummary {
   long zupt_samples = 0;             ///< samples flagged as stance by the detector
   long zaru_updates = 0;             ///< ZUPTs that carried ZARU rows
   long zaru_rejected = 0;            ///< ZARU rows dropped by the innovation gate (zaru_gate_probability)
+  /// mechanization intervals closed early at a stance shorter than the interval (ins::zupt_forced_interval_ends)
+  long zupt_short_stance_interval_ends = 0;
   long step_velocity_updates = 0;    ///< seed 000 step-velocity updates applied
   long gnss_epochs = 0;              ///< rover epochs read
   long gnss_epochs_used = 0;         ///< epochs with at least one accepted measurement

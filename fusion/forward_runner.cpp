@@ -40,6 +40,12 @@ ForwardRunner::ForwardRunner(const EngineInputs& in, const EngineOptions& o,
     // The stance samples a ZUPT may use; the core of a short stance spans one mechanization interval, so that
     // every detected stance keeps at least one update.
     zupt_ok_ = ins::zupt_update_samples(decisions, *in.imu, o.zupt_edge_s, 1.0 / o.mechanization_rate_hz);
+    // A stance shorter than the mechanization interval may hold no interval end: its interval then ends at the
+    // stance (docs/zupt.md §5), so that every detected stance keeps a ZUPT.
+    if (o.zupt_updates) {
+      forced_end_ = ins::zupt_forced_interval_ends(decisions, zupt_ok_, *in.imu,
+                                                   ins::IncrementIntegrator(ins::IncrementOptions{o.mechanization_rate_hz}).period_ns());
+    }
   }
   if (o.repair_saturation && in.imu) {
     ins::SaturationOptions so;
@@ -266,6 +272,14 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
     const ins::ImuSample corrected = ins::correct_sample(raw, f.x().imu);
     integrator.push(corrected, on_increment);
     if (failed) break;
+    if (sample_index < forced_end_.size() && forced_end_[sample_index]) {
+      ins::ImuIncrement early;
+      if (integrator.cut(early)) {
+        ++sum.zupt_short_stance_interval_ends;
+        on_increment(early);
+      }
+      if (failed) break;
+    }
   }
   // The data ended inside a mechanization interval: that partial interval (up to the last sample) is one more step,
   // so the solution reaches the last sample (without it the last up to 1/rate s of every log were dropped).

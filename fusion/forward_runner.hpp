@@ -77,6 +77,7 @@ class ForwardRunner {
   const EngineOptions& o_;
   const std::vector<ins::ZuptDecision>& decisions_;
   std::vector<bool> zupt_ok_;  // stance samples a ZUPT/ZARU may use (zupt_edge_s trimmed; ins::zupt_update_samples)
+  std::vector<bool> forced_end_;  // samples that close a mechanization interval early (ins::zupt_forced_interval_ends)
   ins::SaturationRepair saturation_;  // clipped samples repaired once per run (docs/ins.md §9)
   StrideVelocity stride_;             // stride-average foot velocity: the antenna velocity (docs/fusion.md §13)
   FrameYaw frame_;

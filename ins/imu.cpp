@@ -89,6 +89,14 @@ bool IncrementIntegrator::flush(ImuIncrement& out) {
   return true;
 }
 
+bool IncrementIntegrator::cut(ImuIncrement& out) {
+  if (!has_last_ || cur_.samples == 0) return false;
+  const GpsTime grid_end = next_end_;
+  out = finish_at(last_);
+  next_end_ = grid_end;  // finish_at moved it one period on: the grid stays where it was
+  return true;
+}
+
 std::vector<ImuIncrement> integrate_all(const std::vector<ImuSample>& samples, const IncrementOptions& options) {
   std::vector<ImuIncrement> out;
   IncrementIntegrator integrator(options);

@@ -71,6 +71,9 @@ class IncrementIntegrator {
   }
   /// Close the current partial interval at the last sample (end of data); false if it is empty.
   bool flush(ImuIncrement& out);
+  /// Close the current partial interval at the last sample without moving the grid: the next interval ends at the
+  /// same grid point as this one would have (a short stance's ZUPT, ins::zupt_forced_interval_ends); false if empty.
+  bool cut(ImuIncrement& out);
   /// Period of the mechanization grid [ns].
   int64_t period_ns() const { return period_ns_; }
   const IncrementOptions& options() const { return options_; }

@@ -268,10 +268,10 @@ std::vector<std::pair<std::size_t, std::size_t>> stance_phases(const std::vector
   return out;
 }
 
-std::vector<bool> zupt_update_samples(const std::vector<ZuptDecision>& d, const std::vector<ImuSample>& s,
-                                      double edge_s, double min_core_s) {
-  const std::size_t n = std::min(d.size(), s.size());
-  std::vector<bool> ok(d.size(), false);
+namespace {
+// f(i, j) for every run of stance decisions d[i..j] (inclusive) among the first n.
+template <typename F>
+void for_each_stance_run(const std::vector<ZuptDecision>& d, std::size_t n, F&& f) {
   for (std::size_t i = 0; i < n;) {
     if (!d[i].stance) {
       ++i;
@@ -279,6 +279,16 @@ std::vector<bool> zupt_update_samples(const std::vector<ZuptDecision>& d, const 
     }
     std::size_t j = i;
     while (j + 1 < n && d[j + 1].stance) ++j;
+    f(i, j);
+    i = j + 1;
+  }
+}
+}  // namespace
+
+std::vector<bool> zupt_update_samples(const std::vector<ZuptDecision>& d, const std::vector<ImuSample>& s,
+                                      double edge_s, double min_core_s) {
+  std::vector<bool> ok(d.size(), false);
+  for_each_stance_run(d, std::min(d.size(), s.size()), [&](std::size_t i, std::size_t j) {
     // Times from the run's first sample: the run without its edges, or else its central min_core_s.
     const double len = s[j].t - s[i].t;
     double lo = edge_s, hi = len - edge_s;
@@ -294,9 +304,30 @@ std::vector<bool> zupt_update_samples(const std::vector<ZuptDecision>& d, const 
       any = any || ok[k];
     }
     if (!any) ok[i + (j - i) / 2] = true;
-    i = j + 1;
-  }
+  });
   return ok;
+}
+
+std::vector<bool> zupt_forced_interval_ends(const std::vector<ZuptDecision>& d, const std::vector<bool>& ok,
+                                            const std::vector<ImuSample>& s, int64_t period_ns) {
+  const std::size_t n = std::min({d.size(), ok.size(), s.size()});
+  std::vector<bool> cut(d.size(), false);
+  if (period_ns <= 0) return cut;
+  // Grid points in (a, b]: floor(b / P) − floor(a / P) (times in ns, P > 0; floor division for negative times too).
+  auto floor_div = [period_ns](int64_t t) { return t >= 0 ? t / period_ns : -((-t + period_ns - 1) / period_ns); };
+  auto completes = [&](std::size_t k) { return k > 0 && floor_div(s[k].t.ns()) > floor_div(s[k - 1].t.ns()); };
+  for_each_stance_run(d, n, [&](std::size_t i, std::size_t j) {
+    bool updated = false;
+    std::size_t first_ok = n, last_ok = n;
+    for (std::size_t k = i; k <= j; ++k) {
+      if (!ok[k]) continue;
+      if (first_ok == n) first_ok = k;
+      last_ok = k;
+      updated = updated || completes(k);
+    }
+    if (!updated && first_ok < n) cut[first_ok + (last_ok - first_ok) / 2] = true;
+  });
+  return cut;
 }
 
 std::string stance_label_problem(const ZuptDetectorOptions& o, const std::vector<uint8_t>* labels, size_t n_samples) {

@@ -135,4 +135,12 @@ std::vector<std::pair<std::size_t, std::size_t>> stance_phases(const std::vector
 std::vector<bool> zupt_update_samples(const std::vector<ZuptDecision>& d, const std::vector<ImuSample>& s,
                                       double edge_s, double min_core_s);
 
+/// The samples at which a mechanization interval must end so that every stance run keeps a ZUPT (docs/zupt.md §5):
+/// the intervals end on a grid of period_ns (ins::IncrementIntegrator), and the ZUPT happens at an interval end whose
+/// sample is in `ok` (zupt_update_samples). A run of `ok` samples of one stance in which no sample completes a grid
+/// interval (t[k−1] < n·period ≤ t[k]) — a stance shorter than the interval, e.g. 20–50 ms of a running step at 20 Hz
+/// — gets its middle `ok` sample flagged: the forward pass closes the interval there (IncrementIntegrator::cut).
+std::vector<bool> zupt_forced_interval_ends(const std::vector<ZuptDecision>& d, const std::vector<bool>& ok,
+                                            const std::vector<ImuSample>& s, int64_t period_ns);
+
 }  // namespace pednav::ins

@@ -373,7 +373,8 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
   if (c.step_velocity.enabled) j["step_velocity"] = {{"updates", sum.step_velocity_updates}};
   j["zupt"] = {{"detector", c.zupt.detector}, {"form", c.zupt.form}, {"updates", sum.zupt_updates},
                {"stance_samples", sum.zupt_samples}, {"zaru_updates", sum.zaru_updates},
-               {"zaru_rejected_by_gate", sum.zaru_rejected}};
+               {"zaru_rejected_by_gate", sum.zaru_rejected},
+               {"short_stance_interval_ends", sum.zupt_short_stance_interval_ends}};
   if (opt.mode == fusion::Mode::kTightlyCoupled) {
     j["gnss"] = {{"epochs_read", sum.gnss_epochs},
                  {"epochs_used", sum.gnss_epochs_used},

@@ -40,6 +40,39 @@ TEST(IncrementIntegrator, IntervalsLieOnTheGpsTimeGridForAnyRate) {
   }
 }
 
+// IncrementIntegrator::cut closes the interval at the last sample and keeps the grid: the next interval ends at the
+// grid point the cut one would have reached, and the increments add up to those of the uncut integration.
+TEST(IncrementIntegrator, CutKeepsTheGrid) {
+  std::vector<ImuSample> s;
+  for (int i = 0; i < 41; ++i) {
+    ImuSample x;
+    x.t = GpsTime::from_ns(2'500'000LL + i * 5'000'000LL);
+    x.omega_ib_b = Eigen::Vector3d(0.3 + 0.01 * i, -0.2, 0.1);
+    x.f_ib_b = Eigen::Vector3d(0.5, 0.0, -9.8 + 0.02 * i);
+    s.push_back(x);
+  }
+  IncrementIntegrator whole({20.0, true, true}), cut({20.0, true, true});
+  std::vector<ImuIncrement> a, b;
+  for (const auto& x : s) whole.push(x, [&](const ImuIncrement& inc) { a.push_back(inc); });
+  for (size_t i = 0; i < s.size(); ++i) {
+    cut.push(s[i], [&](const ImuIncrement& inc) { b.push_back(inc); });
+    ImuIncrement early;
+    if (i == 13) {  // 67.5 ms: inside the interval (50, 100] ms
+      ASSERT_TRUE(cut.cut(early));
+      b.push_back(early);
+      EXPECT_FALSE(cut.cut(early));  // nothing left to close at the same sample
+    }
+  }
+  ASSERT_EQ(b.size(), a.size() + 1);
+  EXPECT_EQ(b[1].t1.ns(), 67'500'000);
+  EXPECT_EQ(b[2].t0.ns(), 67'500'000);
+  EXPECT_EQ(b[2].t1.ns(), 100'000'000);  // the grid point the cut interval would have reached
+  for (size_t i = 3; i < b.size(); ++i) EXPECT_EQ(b[i].t1, a[i - 1].t1);
+  EXPECT_TRUE((b[1].alpha_b + b[2].alpha_b).isApprox(a[1].alpha_b, 1e-12));
+  EXPECT_TRUE((b[1].upsilon_b + b[2].upsilon_b).isApprox(a[1].upsilon_b, 1e-12));
+  EXPECT_EQ(b[1].samples + b[2].samples, a[1].samples);
+}
+
 // Classic coning: R_i_b(t) = Rz(Ωt) Rx(β) Rz(-Ωt); body rate ω_b = Ω (R^T e_z - e_z) (exact), so the
 // attitude is known in closed form; the uncompensated algorithm drifts about the cone axis at
 // ≈ Ω (1 - cos β) minus what the sum of plain increments captures (Savage 1998 Part 1).

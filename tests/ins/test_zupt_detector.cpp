@@ -427,5 +427,31 @@ TEST(ZuptDetector, UpdateSamplesSkipTheStanceEdges) {
   for (int k = 0; k < 100; ++k) EXPECT_EQ(flags[k], d[k].stance) << "sample " << k;
 }
 
+// zupt_forced_interval_ends (docs/zupt.md §5) at 200 Hz with a 20-Hz grid (50 ms): samples at 2.5 ms + 5 ms k, so
+// sample k completes a grid interval when k = 10 j (grid point 50 j ms lies between samples 10 j − 1 and 10 j).
+// A 25-ms stance between two grid points gets its middle sample; a stance that spans a grid point does not; a stance
+// whose grid-completing sample is not usable (ok false) gets the middle of its usable samples; a stance without a
+// usable sample gets nothing.
+TEST(ZuptDetector, ShortStancesWithoutAnIntervalEndGetOne) {
+  const int n = 100;
+  std::vector<ImuSample> s(n);
+  std::vector<ZuptDecision> d(n);
+  for (int k = 0; k < n; ++k) s[k].t = GpsTime::from_ns(2'500'000LL + 5'000'000LL * k);
+  const int64_t period = 50'000'000;
+  for (int k = 12; k <= 16; ++k) d[k].stance = true;  // 62.5-82.5 ms: no grid point (50, 100 ms) inside
+  for (int k = 28; k <= 33; ++k) d[k].stance = true;  // 142.5-167.5 ms: sample 30 (152.5 ms) completes 150 ms
+  for (int k = 48; k <= 53; ++k) d[k].stance = true;  // sample 50 completes 250 ms, but only 51-53 are usable
+  for (int k = 70; k <= 72; ++k) d[k].stance = true;  // no usable sample
+  std::vector<bool> ok(n, false);
+  for (int k = 0; k < n; ++k) ok[k] = d[k].stance && !(k >= 48 && k <= 50) && !(k >= 70 && k <= 72);
+  const std::vector<bool> cut = zupt_forced_interval_ends(d, ok, s, period);
+  for (int k = 0; k < n; ++k) EXPECT_EQ(cut[k], k == 14 || k == 52) << "sample " << k;
+  // No stance at all, or a non-positive period: nothing to cut.
+  const std::vector<bool> none = zupt_forced_interval_ends(std::vector<ZuptDecision>(n), ok, s, period);
+  EXPECT_EQ(std::count(none.begin(), none.end(), true), 0);
+  const std::vector<bool> bad = zupt_forced_interval_ends(d, ok, s, 0);
+  EXPECT_EQ(std::count(bad.begin(), bad.end(), true), 0);
+}
+
 }  // namespace
 }  // namespace pednav::ins
