@@ -408,6 +408,9 @@ std::string health_html(const nlohmann::json& j, const std::vector<std::string>&
       std::string z = fmt::format("{} ZUPT updates", n);
       if (const long long zr = count_at(j, "zupt.zaru_updates"); zr >= 0) z += fmt::format(", {} ZARU", zr);
       if (const long long g = count_at(j, "zupt.zaru_rejected_by_gate"); g > 0) z += fmt::format(" ({} gated out)", g);
+      if (const long long c = count_at(j, "zupt.short_stance_interval_ends"); c > 0) {
+        z += fmt::format("; {} stances shorter than a mechanization interval closed their own", c);
+      }
       rows.push_back({"stance updates", z});
     }
     if (const auto* v = at_path(j, "smoother.message")) rows.push_back({"smoother", pretty(*v)});

@@ -52,7 +52,7 @@ inline void write_report_fixture(const std::string& dir) {
   std::ofstream(dir + "/summary.json")
       << "{\"mode\": \"tc\", \"output_epochs\": 300, \"initial_yaw_deg\": 92.86770608856047, "
          "\"initial_gyro_bias_deg_per_h\": [2424.9135795483744, 271.8266973372757, -0.000012345678], "
-         "\"zupt\": {\"updates\": 150, \"zaru_updates\": 140, \"zaru_rejected_by_gate\": 0}, "
+         "\"zupt\": {\"updates\": 150, \"zaru_updates\": 140, \"zaru_rejected_by_gate\": 0, \"short_stance_interval_ends\": 3}, "
          "\"gnss\": {\"epochs_read\": 300, \"epochs_skipped_no_base\": 2, \"epochs_outside_imu_span\": 0, "
          "\"code\": {\"below_elevation_mask\": 30, \"innovation_fault\": 6, \"persistent_fault\": 1, \"used\": 1763}, "
          "\"doppler\": {\"innovation_fault\": 0, \"used\": 1800}}, "
