@@ -113,6 +113,27 @@ std::string to_yaml(const RunConfig& c) {
   e << YAML::Key << "elevation_weight" << YAML::Value << c.gnss.elevation_weight;
   e << YAML::Key << "code_squaring_loss" << YAML::Value << c.gnss.code_squaring_loss;
   e << YAML::Key << "code_smoothing_s" << YAML::Value << c.gnss.code_smoothing_s;
+  e << YAML::Key << "carrier" << YAML::Value << c.gnss.carrier;
+  e << YAML::Key << "carrier_sigma_zenith_m" << YAML::Value << c.gnss.carrier_sigma_zenith_m;
+  e << YAML::Key << "carrier_base_age_sigma_mps" << YAML::Value << c.gnss.carrier_base_age_sigma_mps;
+  e << YAML::Key << "rtk_accel_sigma_horizontal_mps2" << YAML::Value << c.gnss.rtk_accel_sigma_horizontal_mps2;
+  e << YAML::Key << "rtk_accel_sigma_vertical_mps2" << YAML::Value << c.gnss.rtk_accel_sigma_vertical_mps2;
+  {
+    const auto& a = c.gnss.ambiguity;
+    e << YAML::Key << "ambiguity" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "ratio_threshold" << YAML::Value << a.ratio_threshold;
+    e << YAML::Key << "min_success_rate" << YAML::Value << a.min_success_rate;
+    e << YAML::Key << "elevation_mask_deg" << YAML::Value << a.elevation_mask_deg;
+    e << YAML::Key << "partial" << YAML::Value << a.partial;
+    e << YAML::Key << "min_ambiguities" << YAML::Value << a.min_ambiguities;
+    e << YAML::Key << "min_lock_epochs" << YAML::Value << a.min_lock_epochs;
+    e << YAML::Key << "hold" << YAML::Value << a.hold;
+    e << YAML::Key << "hold_min_epochs" << YAML::Value << a.hold_min_epochs;
+    e << YAML::Key << "hold_sigma_cycles" << YAML::Value << a.hold_sigma_cycles;
+    e << YAML::Key << "validation_w" << YAML::Value << a.validation_w;
+    e << YAML::Key << "glonass" << YAML::Value << a.glonass;
+    e << YAML::EndMap;
+  }
   e << YAML::EndMap;
   if (!c.imu.file.empty()) {
     e << YAML::Key << "imu" << YAML::Value << YAML::BeginMap << YAML::Key << "file" << YAML::Value << c.imu.file;

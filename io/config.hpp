@@ -47,6 +47,27 @@ struct GnssConfig {
   double elevation_weight = 1.0;
   /// b of docs/gnss.md eq. W2: the DLL squaring loss at cn0_ref_dbhz, 2 / ((2 − d) T C/N0_ref); 0 = off.
   double code_squaring_loss = 0.0;
+  /// L1 carrier phase (docs/carrier.md): auto = used when the rover and base RINEX have L observations; on = required
+  /// (an error without them); off = code and Doppler only (the outputs of pednav 0.2).
+  std::string carrier = "auto";
+  double carrier_sigma_zenith_m = 0.003;     ///< one receiver's phase noise at zenith and C/N0 >= cn0_ref_dbhz [m]
+  double carrier_base_age_sigma_mps = 0.003; ///< phase noise added per second of base-epoch age [m/s]
+  double rtk_accel_sigma_horizontal_mps2 = 1.0;  ///< pednav gnss RTK: white acceleration √PSD, horizontal [m/s²/√Hz]
+  double rtk_accel_sigma_vertical_mps2 = 0.5;    ///< the vertical one
+  /// `gnss.ambiguity:` integer resolution (docs/carrier.md §3).
+  struct Ambiguity {
+    double ratio_threshold = 3.0;
+    double min_success_rate = 0.999;
+    double elevation_mask_deg = 15.0;
+    bool partial = true;
+    int min_ambiguities = 4;
+    int min_lock_epochs = 3;
+    bool hold = false;
+    int hold_min_epochs = 5;
+    double hold_sigma_cycles = 0.01;
+    double validation_w = 4.0;
+    bool glonass = false;
+  } ambiguity;
 };
 
 /// `imu:` section.

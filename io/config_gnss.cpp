@@ -40,6 +40,25 @@ void read_gnss_section(YamlMap& top, GnssConfig& out) {
   g.number("elevation_weight", out.elevation_weight, false, 0.0, 1.0);
   g.number("code_squaring_loss", out.code_squaring_loss, false, 0.0, 10.0);
   g.number("code_smoothing_s", out.code_smoothing_s, false, 0.0, 3600.0);
+  g.choice("carrier", out.carrier, {"auto", "on", "off"});
+  g.number("carrier_sigma_zenith_m", out.carrier_sigma_zenith_m, false, 0.0001, 1.0);
+  g.number("carrier_base_age_sigma_mps", out.carrier_base_age_sigma_mps, false, 0.0, 1.0);
+  g.number("rtk_accel_sigma_horizontal_mps2", out.rtk_accel_sigma_horizontal_mps2, false, 0.001, 100.0);
+  g.number("rtk_accel_sigma_vertical_mps2", out.rtk_accel_sigma_vertical_mps2, false, 0.001, 100.0);
+  YamlMap a = g.map("ambiguity");
+  auto& o = out.ambiguity;
+  a.number("ratio_threshold", o.ratio_threshold, false, 1.0, 1000.0);
+  a.number("min_success_rate", o.min_success_rate, false, 0.0, 1.0);
+  a.number("elevation_mask_deg", o.elevation_mask_deg, false, 0.0, 90.0);
+  a.boolean("partial", o.partial);
+  a.integer("min_ambiguities", o.min_ambiguities, false, 1, 100);
+  a.integer("min_lock_epochs", o.min_lock_epochs, false, 0, 100000);
+  a.boolean("hold", o.hold);
+  a.integer("hold_min_epochs", o.hold_min_epochs, false, 1, 100000);
+  a.number("hold_sigma_cycles", o.hold_sigma_cycles, false, 0.0001, 1.0);
+  a.number("validation_w", o.validation_w, false, 1.0, 100.0);
+  a.boolean("glonass", o.glonass);
+  a.finish();
 }
 
 }  // namespace pednav::io

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 
 #include "core/geodesy.hpp"
@@ -18,9 +19,11 @@ double signed_sqrt(double v) { return v < 0.0 ? -std::sqrt(-v) : std::sqrt(v); }
 
 }  // namespace
 
-std::string solution_csv_header() {
-  return "gps_week,gps_tow_s,lat_deg,lon_deg,h_m,x_m,y_m,z_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg,"
-         "sd_n_m,sd_e_m,sd_d_m,sd_yaw_deg,n_sats_used,n_sats_rejected,zupt,hdop,pdop";
+std::string solution_csv_header(bool carrier) {
+  std::string h = "gps_week,gps_tow_s,lat_deg,lon_deg,h_m,x_m,y_m,z_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg,"
+                  "sd_n_m,sd_e_m,sd_d_m,sd_yaw_deg,n_sats_used,n_sats_rejected,zupt,hdop,pdop";
+  if (carrier) h += ",solution_status,n_fixed_ambiguities,ar_ratio";
+  return h;
 }
 
 std::string solution_csv_line(const SolutionRow& r) {
@@ -48,14 +51,22 @@ std::string solution_csv_line(const SolutionRow& r) {
   if (r.hdop) fmt::format_to(out, FMT_COMPILE("{:.2f}"), *r.hdop);
   b.push_back(',');
   if (r.pdop) fmt::format_to(out, FMT_COMPILE("{:.2f}"), *r.pdop);
+  if (r.solution_status) {
+    fmt::format_to(out, FMT_COMPILE(",{},{},{:.2f}"), r.solution_status, r.n_fixed_ambiguities, r.ar_ratio);
+  }
   return fmt::to_string(b);
 }
 
 Expected<void> write_solution_csv(const std::string& path, const std::vector<SolutionRow>& rows) {
   AtomicFile f(path);
   if (!f.ok()) return make_error(path + ": cannot create the output file");
-  f.stream() << solution_csv_header() << '\n';
-  for (const auto& r : rows) f.stream() << solution_csv_line(r) << '\n';
+  const bool carrier = std::any_of(rows.begin(), rows.end(), [](const SolutionRow& r) { return r.solution_status; });
+  f.stream() << solution_csv_header(carrier) << '\n';
+  for (const auto& r : rows) {
+    f.stream() << solution_csv_line(r);
+    if (carrier && !r.solution_status) f.stream() << ",,,";
+    f.stream() << '\n';
+  }
   return f.commit();
 }
 
@@ -79,7 +90,7 @@ Expected<void> write_solution_pos(const std::string& path, const std::vector<Sol
                      c.year, c.month, c.day, c.hour, c.minute, c.second, llh.lat * kRadToDeg, llh.lon * kRadToDeg,
                      llh.h_m, r.pos_quality, r.n_sats_used, std::sqrt(std::max(0.0, P(0, 0))),
                      std::sqrt(std::max(0.0, P(1, 1))), std::sqrt(std::max(0.0, P(2, 2))), signed_sqrt(P(0, 1)),
-                     signed_sqrt(-P(1, 2)), signed_sqrt(-P(2, 0)), r.age_s, 0.0);
+                     signed_sqrt(-P(1, 2)), signed_sqrt(-P(2, 0)), r.age_s, std::min(r.ar_ratio, 9999.9));
   }
   return f.commit();
 }

@@ -26,10 +26,15 @@ struct SolutionRow {
   int pos_quality = 5;  ///< RTKLIB Q: 1 fix, 2 float, 4 DGPS, 5 single
   double age_s = 0.0;   ///< differential age [s] (.pos column)
   std::optional<double> hdop, pdop;  ///< extra CSV columns (after the DESIGN.md ones)
+  /// With carrier phase (docs/carrier.md §6): fixed | float | code | ins; the columns solution_status,
+  /// n_fixed_ambiguities, ar_ratio follow pdop when any row of a file has a status.
+  const char* solution_status = nullptr;
+  int n_fixed_ambiguities = 0;
+  double ar_ratio = 0.0;  ///< also the .pos ratio column
 };
 
-/// The DESIGN.md solution.csv header (+ hdop, pdop).
-std::string solution_csv_header();
+/// The DESIGN.md solution.csv header (+ hdop, pdop; + solution_status, n_fixed_ambiguities, ar_ratio with carrier).
+std::string solution_csv_header(bool carrier = false);
 /// One CSV line (no newline) of a row.
 std::string solution_csv_line(const SolutionRow& row);
 /// Write rows as CSV to `path` atomically.

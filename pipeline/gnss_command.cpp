@@ -16,6 +16,7 @@
 #include "io/atomic_file.hpp"
 #include "io/log.hpp"
 #include "io/solution_writer.hpp"
+#include "pipeline/reference_evaluation.hpp"
 
 namespace pednav::pipeline {
 
@@ -95,6 +96,24 @@ std::string summary_json(const GnssRunSummary& s, const RunConfig& c) {
   };
   j += fmt::format("  \"code_smoothing\": {{\"window_s\": {}, \"rover\": {}, \"base\": {}}},\n",
                    json_number(c.gnss.code_smoothing_s), sm(s.smoothing_rover), sm(s.smoothing_base));
+  if (s.carrier) {
+    const auto& r = s.rtk;
+    std::string slips = "{";
+    for (int k = 0; k < static_cast<int>(gnss::SlipReason::kCount); ++k) {
+      slips += fmt::format("{}\"{}\": {}", k ? ", " : "", gnss::slip_reason_name(static_cast<gnss::SlipReason>(k)),
+                           r.slips[k]);
+    }
+    slips += "}";
+    j += fmt::format(
+        "  \"carrier\": {{\"used\": true, \"epochs\": {}, \"fixed\": {}, \"float\": {}, \"code\": {}, \"none\": {}, "
+        "\"fix_rate_pct\": {}, \"time_to_first_fix_s\": {}, \"fix_attempts\": {}, \"not_fixed\": {}, "
+        "\"fixes_rejected_by_validation\": {}, \"wrong_fix_detections\": {}, \"holds\": {}, \"slips\": {}, "
+        "\"code_rows_excluded\": {}, \"doppler_rows_excluded\": {}}},\n",
+        r.epochs, r.fixed, r.float_, r.code, r.none, json_number(r.epochs ? 100.0 * r.fixed / r.epochs : 0.0),
+        r.time_to_first_fix_s ? json_number(*r.time_to_first_fix_s) : "null", r.fix_attempts, map_json(r.not_fixed),
+        r.fixes_rejected_by_validation, r.wrong_fix_detections, r.holds, slips, r.code_rows_excluded,
+        r.doppler_rows_excluded);
+  }
   j += fmt::format("  \"wall_s\": {}\n}}\n", json_number(s.wall_s));
   return j;
 }
@@ -196,12 +215,95 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
 
   std::vector<SolutionRow> rows;
   rows.reserve(rover->epochs.size());
+  // Carrier phase (docs/carrier.md §4): with a base and L1 phase in both files, unless gnss.carrier: off.
+  auto has_phase = [](const gnss::ObsData& d) {
+    for (const auto& e : d.epochs) {
+      for (const auto& s : e.sats) {
+        if (std::isfinite(s.carrier_cycles)) return true;
+      }
+    }
+    return false;
+  };
+  if (g.carrier != "off") {
+    if (!base) sum.carrier_note = "no base_obs (the carrier needs a base in pednav gnss)";
+    else if (!has_phase(*rover)) sum.carrier_note = g.rover_obs + " has no L1 carrier phase";
+    else if (!has_phase(*base)) sum.carrier_note = g.base_obs + " has no L1 carrier phase";
+    if (sum.carrier_note.empty()) {
+      sum.carrier = true;
+    } else if (g.carrier == "on") {
+      return make_error(config.source_file + ": gnss.carrier: on, but " + sum.carrier_note);
+    } else {
+      spdlog::info("gnss.carrier auto: {}: code and Doppler only", sum.carrier_note);
+    }
+  }
+  if (sum.carrier) {
+    fusion::RtkOptions ro;
+    ro.systems.clear();
+    for (const auto& l : g.systems) {
+      if (l == "G") ro.systems.push_back(gnss::System::kGps);
+      if (l == "R") ro.systems.push_back(gnss::System::kGlonass);
+      if (l == "E") ro.systems.push_back(gnss::System::kGalileo);
+      if (l == "C") ro.systems.push_back(gnss::System::kBeidou);
+      if (l == "J") ro.systems.push_back(gnss::System::kQzss);
+    }
+    ro.elevation_mask_rad = g.elevation_mask_rad;
+    ro.min_cn0_dbhz = g.min_cn0_dbhz;
+    ro.weights = opt.weights;
+    ro.fault_probability = opt.fault_probability;
+    ro.use_doppler = g.use_doppler;
+    ro.carrier_sigma_zenith_m = g.carrier_sigma_zenith_m;
+    ro.base_age_sigma_mps = g.carrier_base_age_sigma_mps;
+    ro.accel_sigma_horizontal_mps2 = g.rtk_accel_sigma_horizontal_mps2;
+    ro.accel_sigma_vertical_mps2 = g.rtk_accel_sigma_vertical_mps2;
+    const auto& a = g.ambiguity;
+    ro.ar.ratio_threshold = a.ratio_threshold;
+    ro.ar.min_success_rate = a.min_success_rate;
+    ro.ar.ar_elevation_mask_rad = a.elevation_mask_deg * kDegToRad;
+    ro.ar.partial = a.partial;
+    ro.ar.min_ambiguities = a.min_ambiguities;
+    ro.ar.min_lock_epochs = a.min_lock_epochs;
+    ro.ar.hold = a.hold;
+    ro.ar.hold_min_epochs = a.hold_min_epochs;
+    ro.ar.hold_sigma_cycles = a.hold_sigma_cycles;
+    ro.ar.validation_w = a.validation_w;
+    ro.ar.glonass = a.glonass;
+    fusion::RtkFilter rtk(*nav, base->epochs, p_base, ro);
+    Progress progress("gnss rtk", static_cast<int64_t>(rover->epochs.size()), progress_enabled());
+    for (size_t i = 0; i < rover->epochs.size(); ++i) {
+      progress.update(static_cast<int64_t>(i));
+      const fusion::RtkEpoch e = rtk.process(rover->epochs[i], matches[i].base_index);
+      if (e.status == fusion::SolutionStatus::kNone) {
+        ++sum.not_solved[matches[i].base_index < 0 ? gnss::epoch_failure_name(gnss::EpochFailure::kNoBaseEpoch)
+                                                   : gnss::epoch_failure_name(gnss::EpochFailure::kTooFewSatellites)];
+        continue;
+      }
+      ++sum.epochs_solved;
+      ++sum.epochs_with_velocity;
+      SolutionRow row;
+      row.time = e.time;
+      row.p_e = e.p_ea_e;
+      const Geodetic llh = geodetic_from_ecef(e.p_ea_e);
+      const Eigen::Matrix3d R_ne = R_e_n(llh.lat, llh.lon).transpose();
+      row.v_n = R_ne * e.v_ea_e;
+      row.cov_p_n = R_ne * e.cov_p_e * R_ne.transpose();
+      row.n_sats_used = e.n_sats;
+      row.n_sats_rejected = e.n_rejected;
+      row.pos_quality = fusion::pos_quality(e.status);
+      row.age_s = e.base_age_s;
+      row.solution_status = fusion::solution_status_name(e.status);
+      row.n_fixed_ambiguities = e.n_fixed;
+      row.ar_ratio = e.ratio;
+      rows.push_back(row);
+    }
+    progress.finish();
+    sum.rtk = rtk.summary();
+  }
   for (int r = 0; r < static_cast<int>(gnss::RejectReason::kCount); ++r) {
     sum.satellites_rejected[gnss::reject_reason_name(static_cast<gnss::RejectReason>(r))] = 0;
   }
   Eigen::Vector3d p_prev = Eigen::Vector3d::Zero();
   Progress progress("gnss", static_cast<int64_t>(rover->epochs.size()), progress_enabled());
-  for (size_t i = 0; i < rover->epochs.size(); ++i) {
+  for (size_t i = 0; i < rover->epochs.size() && !sum.carrier; ++i) {
     progress.update(static_cast<int64_t>(i));
     const gnss::ObsEpoch& re = rover->epochs[i];
     gnss::EpochSolution sol;
@@ -254,9 +356,17 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
   const std::string dir = out_dir + "/";
   if (auto ok = write_solution_csv(dir + "gnss.csv", rows); !ok) return ok.error();
   std::vector<std::string> comment{"pednav gnss " + config.source_file,
-                                   std::string("mode        : ") + (base ? "single-differenced code (DGPS)"
-                                                                         : "undifferenced code (single)")};
+                                   std::string("mode        : ") + (sum.carrier ? "kinematic RTK (SD code, Doppler, L1 phase)"
+                                                                    : base     ? "single-differenced code (DGPS)"
+                                                                               : "undifferenced code (single)")};
   if (auto ok = write_solution_pos(dir + "gnss.pos", rows, comment); !ok) return ok.error();
+  if (!config.reference.file.empty()) {
+    auto ref = read_configured_reference(config);
+    if (!ref) return ref.error();
+    auto figures = evaluate_rows(rows, *ref, config.reference.file, dir + "gnss.csv", dir + "evaluation.json", "gnss");
+    if (!figures) return figures.error();
+    sum.evaluation = *figures;
+  }
   sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (auto ok = write_file_atomic(dir + "summary.json", summary_json(sum, config)); !ok) return ok.error();
   return sum;

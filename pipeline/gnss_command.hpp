@@ -1,13 +1,17 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // `pednav gnss CONFIG.yaml -o OUT`: GNSS-only epoch-by-epoch least squares (SD with a base, else undifferenced)
-// -> gnss.csv, gnss.pos, summary.json (all written atomically).
+// -> gnss.csv, gnss.pos, summary.json (all written atomically). With a base and L1 carrier phase in both files
+// (gnss.carrier auto/on): kinematic RTK (fusion/rtk_filter, docs/carrier.md §4). With a reference: evaluation.json.
 #pragma once
 
 #include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "core/expected.hpp"
 #include "gnss/code_smoothing.hpp"
+#include "fusion/rtk_filter.hpp"
 #include "gnss/epoch_matching.hpp"
 #include "io/config.hpp"
 
@@ -24,6 +28,10 @@ struct GnssRunSummary {
   gnss::AgeStats base_age;
   gnss::CodeSmoothingStats smoothing_rover, smoothing_base;  ///< Doppler smoothing of the code (docs/gnss.md "Doppler smoothing of the code")
   double wall_s = 0.0;
+  bool carrier = false;                   ///< RTK with L1 carrier phase (docs/carrier.md §4)
+  std::string carrier_note;               ///< why the carrier is not used (gnss.carrier: auto)
+  fusion::RtkSummary rtk;                 ///< with carrier
+  std::optional<nlohmann::json> evaluation;  ///< with a reference
 };
 
 /// Run the GNSS-only solution for a loaded configuration and write the outputs into out_dir (created).

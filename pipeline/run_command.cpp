@@ -16,6 +16,7 @@
 #include "io/atomic_file.hpp"
 #include "io/residuals_writer.hpp"
 #include "pipeline/compare_command.hpp"
+#include "pipeline/reference_evaluation.hpp"
 #include "io/hmm_model_io.hpp"
 #include "io/imu_csv.hpp"
 #include "io/solution_writer.hpp"
@@ -401,36 +402,14 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
   j["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   if (!c.reference.file.empty()) {
-    TrajectoryReadOptions ro;
-    auto fmt_ = parse_trajectory_format(c.reference.format);
-    if (fmt_) ro.format = *fmt_;
-    ro.nmea_qualities = std::set<int>(c.reference.nmea_qualities.begin(), c.reference.nmea_qualities.end());
-    auto ref = read_trajectory(c.reference.file, ro);
+    auto ref = read_configured_reference(c);
     if (!ref) return ref.error();
     // Forward solution -> evaluation.json (unchanged); smoothed -> evaluation_smoothed.json.
     auto evaluate = [&](const std::vector<SolutionRow>& rs, const std::string& csv, const std::string& json_name,
                         const std::string& key, const std::string& what) -> Expected<void> {
-      eval::Trajectory sol;
-      for (const auto& r : rs) {
-        const Eigen::Vector3d sd_enu(std::sqrt(r.cov_p_n(1, 1)), std::sqrt(r.cov_p_n(0, 0)), std::sqrt(r.cov_p_n(2, 2)));
-        sol.points.push_back({r.time, r.p_e, sd_enu});
-      }
-      auto ev = eval::compare(sol, ref->trajectory, eval::CompareOptions{});
-      if (!ev) return make_error("evaluation against " + c.reference.file + ": " + ev.error().message);
-      CompareArgs args;
-      args.solution = (out / csv).string();
-      args.reference = c.reference.file;
-      TrajectoryFile sf;
-      sf.format = "csv";
-      sf.trajectory = sol;
-      if (auto ok = write_file_atomic((out / json_name).string(), evaluation_json(*ev, args, sf, *ref)); !ok) {
-        return ok.error();
-      }
-      j[key] = {{"horizontal_rms_m", ev->horizontal_rms_m}, {"horizontal_max_m", ev->horizontal_max_m},
-                {"availability_pct", ev->availability_pct}, {"lt5_pct", ev->bins_pct[0]},
-                {"inside_3sigma_pct", eval::consistency_statistics(ev->errors).inside_3sigma_pct}};
-      spdlog::info("{} vs reference: horizontal RMS {:.2f} m, p95 {:.2f} m, max {:.2f} m, {:.1f} % < 5 m", what,
-                   ev->horizontal_rms_m, ev->horizontal_p95_m, ev->horizontal_max_m, ev->bins_pct[0]);
+      auto figures = evaluate_rows(rs, *ref, c.reference.file, (out / csv).string(), (out / json_name).string(), what);
+      if (!figures) return figures.error();
+      j[key] = *figures;
       return {};
     };
     if (auto ok = evaluate(rows, "solution.csv", "evaluation.json", "evaluation", "forward"); !ok) return ok.error();

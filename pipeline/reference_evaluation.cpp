@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: BSD-2-Clause
+// Evaluation against the configured reference (pipeline/reference_evaluation.hpp).
+#include "pipeline/reference_evaluation.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <set>
+
+#include "eval/statistics.hpp"
+#include "eval/trajectory.hpp"
+#include "io/atomic_file.hpp"
+#include "pipeline/compare_command.hpp"
+
+namespace pednav::pipeline {
+
+using namespace pednav::io;
+
+Expected<TrajectoryFile> read_configured_reference(const RunConfig& c) {
+  TrajectoryReadOptions ro;
+  auto fmt_ = parse_trajectory_format(c.reference.format);
+  if (fmt_) ro.format = *fmt_;
+  ro.nmea_qualities = std::set<int>(c.reference.nmea_qualities.begin(), c.reference.nmea_qualities.end());
+  return read_trajectory(c.reference.file, ro);
+}
+
+Expected<nlohmann::json> evaluate_rows(const std::vector<SolutionRow>& rows, const TrajectoryFile& reference,
+                                       const std::string& reference_name, const std::string& csv_path,
+                                       const std::string& json_path, const std::string& what) {
+  eval::Trajectory sol;
+  for (const auto& r : rows) {
+    const Eigen::Vector3d sd_enu(std::sqrt(r.cov_p_n(1, 1)), std::sqrt(r.cov_p_n(0, 0)), std::sqrt(r.cov_p_n(2, 2)));
+    sol.points.push_back({r.time, r.p_e, sd_enu});
+  }
+  auto ev = eval::compare(sol, reference.trajectory, eval::CompareOptions{});
+  if (!ev) return make_error("evaluation against " + reference_name + ": " + ev.error().message);
+  CompareArgs args;
+  args.solution = csv_path;
+  args.reference = reference_name;
+  TrajectoryFile sf;
+  sf.format = "csv";
+  sf.trajectory = sol;
+  if (auto ok = write_file_atomic(json_path, evaluation_json(*ev, args, sf, reference)); !ok) return ok.error();
+  spdlog::info("{} vs reference: horizontal RMS {:.2f} m, p95 {:.2f} m, max {:.2f} m, {:.1f} % < 5 m", what,
+               ev->horizontal_rms_m, ev->horizontal_p95_m, ev->horizontal_max_m, ev->bins_pct[0]);
+  return nlohmann::json{{"horizontal_rms_m", ev->horizontal_rms_m}, {"horizontal_max_m", ev->horizontal_max_m},
+                        {"availability_pct", ev->availability_pct}, {"lt5_pct", ev->bins_pct[0]},
+                        {"inside_3sigma_pct", eval::consistency_statistics(ev->errors).inside_3sigma_pct}};
+}
+
+}  // namespace pednav::pipeline
