@@ -32,6 +32,9 @@ void add_simulate_command(CLI::App& app, Action& action) {
                    "{} saturated IMU samples, peak rate {:.2f} rad/s, in {:.2f} s -> {}",
                    sum->duration_s, sum->distance_m, sum->strides, sum->imu_samples, sum->rover_epochs,
                    sum->base_epochs, sum->blunder_events, sum->saturated_samples, sum->max_gyro_radps, sum->wall_s, *out);
+      if (sum->carrier_phase)
+        spdlog::info("simulate: L1 carrier phase, {} losses of lock, slips and half-cycle events -> slips.csv",
+                     sum->carrier_events);
       return 0;
     };
   });

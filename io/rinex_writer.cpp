@@ -56,8 +56,12 @@ Expected<std::string> format_rinex_obs(const gnss::ObsData& obs, const RinexObsH
   const Eigen::Vector3d& p = obs.approx_position_e;
   header_line(out, fmt::format("{:14.4f}{:14.4f}{:14.4f}", p.x(), p.y(), p.z()), "APPROX POSITION XYZ");
   header_line(out, fmt::format("{:14.4f}{:14.4f}{:14.4f}", 0.0, 0.0, 0.0), "ANTENNA: DELTA H/E/N");
-  header_line(out, "G    3 C1C D1C S1C", "SYS / # / OBS TYPES");
+  bool carrier = false;  // L1C column only when a phase is present: code-only files stay as they were
+  for (const auto& e : obs.epochs)
+    for (const auto& s : e.sats) carrier = carrier || std::isfinite(s.carrier_cycles);
+  header_line(out, carrier ? "G    4 C1C L1C D1C S1C" : "G    3 C1C D1C S1C", "SYS / # / OBS TYPES");
   header_line(out, "DBHZ", "SIGNAL STRENGTH UNIT");
+  if (carrier) header_line(out, "G L1C  0.00000", "SYS / PHASE SHIFT");
   header_line(out, fmt::format("{:10.3f}", hdr.interval_s), "INTERVAL");
   const Cal c0 = calendar(obs.epochs.front().time);
   header_line(out, fmt::format("{:6d}{:6d}{:6d}{:6d}{:6d}{:13.7f}     GPS", c0.y, c0.mo, c0.d, c0.h, c0.mi, c0.s),
@@ -71,7 +75,13 @@ Expected<std::string> format_rinex_obs(const gnss::ObsData& obs, const RinexObsH
     const Cal c = calendar(e.time);
     out += fmt::format("> {:4d} {:02d} {:02d} {:02d} {:02d}{:11.7f}  0{:3d}\n", c.y, c.mo, c.d, c.h, c.mi, c.s, e.sats.size());
     for (const auto& s : e.sats) {
-      std::string line = fmt::format("G{:02d}", s.sat.prn) + field(s.pseudorange_m) + field(s.doppler_hz) + field(s.cn0_dbhz);
+      std::string line = fmt::format("G{:02d}", s.sat.prn) + field(s.pseudorange_m);
+      if (carrier) {  // F14.3, LLI digit (blank when 0), blank signal strength
+        line += std::isfinite(s.carrier_cycles)
+                    ? fmt::format("{:14.3f}", s.carrier_cycles) + (s.lli != 0 ? char('0' + (s.lli & 7)) : ' ') + ' '
+                    : std::string(16, ' ');
+      }
+      line += field(s.doppler_hz) + field(s.cn0_dbhz);
       rtrim_line(line);
       out += line;
       out += '\n';

@@ -69,6 +69,22 @@ void read_gnss(YamlMap& g, sim::GnssOptions& o) {
   g.number("blunder_max_m", o.blunder_max_m, false, 0.0, 1e4);
   g.number("blunder_min_s", o.blunder_min_s, false, 0.0, 3600.0);
   g.number("blunder_max_s", o.blunder_max_s, false, 0.0, 3600.0);
+  // L1 carrier phase (docs/sim.md §8).
+  g.boolean("carrier_phase", o.carrier_phase);
+  g.number("atmosphere_sd_iono_fraction", o.atmosphere_sd_iono_fraction, false, 0.0, 1.0);
+  g.number("carrier_tracking_threshold_dbhz", o.carrier_tracking_threshold_dbhz, false, 0.0, 60.0);
+  g.number("carrier_acquisition_threshold_dbhz", o.carrier_acquisition_threshold_dbhz, false, 0.0, 60.0);
+  g.number("pll_bandwidth_hz", o.pll_bandwidth_hz, false, 0.0, 50.0);
+  g.number("pll_integration_time_s", o.pll_integration_time_s, false, 0.001, 0.1);
+  g.number("carrier_multipath_sigma_m", o.carrier_multipath_sigma_m, false, 0.0, 0.1);
+  g.number("carrier_multipath_tau_s", o.carrier_multipath_tau_s, false, 0.01, 1e5);
+  g.integer("carrier_ambiguity_max_cycles", o.carrier_ambiguity_max_cycles, false, 0, 10000000);
+  g.number("carrier_slip_rate_per_s", o.carrier_slip_rate_per_s, false, 0.0, 10.0);
+  g.number("carrier_slip_decade_db", o.carrier_slip_decade_db, false, 0.1, 60.0);
+  g.integer("carrier_slip_max_cycles", o.carrier_slip_max_cycles, false, 1, 1000000);
+  g.number("carrier_slip_flagged_fraction", o.carrier_slip_flagged_fraction, false, 0.0, 1.0);
+  g.number("carrier_half_cycle_probability", o.carrier_half_cycle_probability, false, 0.0, 1.0);
+  g.number("carrier_half_cycle_s", o.carrier_half_cycle_s, false, 0.001, 3600.0);
 }
 
 }  // namespace

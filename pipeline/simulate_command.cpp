@@ -216,6 +216,15 @@ Expected<SimulateSummary> run_simulate_command(const ScenarioFile& file, const s
     for (const auto& x : sim->gnss.blunders)
       b += fmt::format("{},{:.3f},rover,{},{:.3f},{}\n", x.t.week(), x.t.tow_s(), x.sat.to_string(), x.error_m, x.id);
     if (auto r = put("blunders.csv", b); !r) return r.error();
+    if (sim->scenario.gnss.carrier_phase) {  // carrier truth (docs/sim.md §8); no file without carrier phase
+      std::string sl = "gps_week,gps_tow_s,receiver,sat,kind,cycles\n";
+      for (const auto& x : sim->gnss.carrier_events)
+        sl += fmt::format("{},{:.3f},{},{},{},{:.1f}\n", x.t.week(), x.t.tow_s(), x.rover ? "rover" : "base",
+                          x.sat.to_string(), sim::carrier_event_name(x.kind), x.cycles);
+      if (auto r = put("slips.csv", sl); !r) return r.error();
+      sum.carrier_phase = true;
+      sum.carrier_events = static_cast<int>(sim->gnss.carrier_events.size());
+    }
     sum.rover_epochs = static_cast<int>(sim->gnss.rover.epochs.size());
     sum.base_epochs = static_cast<int>(sim->gnss.base.epochs.size());
     sum.blunder_events = sim->gnss.blunder_events;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // `pednav simulate SCENARIO.yaml -o OUT`: runs the simulator and writes truth.csv, imu.csv, rover.obs,
-// base.obs, nav.rnx, blunders.csv, config.yaml and config_datasheet.yaml (each atomically). File formats:
-// docs/sim.md §7.
+// base.obs, nav.rnx, blunders.csv, slips.csv (with carrier phase), config.yaml and config_datasheet.yaml (each
+// atomically). File formats: docs/sim.md §7.
 #pragma once
 
 #include <string>
@@ -22,6 +22,8 @@ struct SimulateSummary {
   long truth_rows = 0;
   int rover_epochs = 0, base_epochs = 0;
   int blunder_events = 0;
+  bool carrier_phase = false;  ///< L1C written (scenario gnss.carrier_phase)
+  int carrier_events = 0;      ///< rows of slips.csv
   long saturated_samples = 0;
   double max_gyro_radps = 0.0;   ///< largest exact |omega| [rad/s]
   double wall_s = 0.0;

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// Rover and base GNSS observations (GPS L1 C/A code, Doppler, C/N0) of the simulator (docs/sim.md §6).
+// Rover and base GNSS observations (GPS L1 C/A code, Doppler, C/N0; L1 carrier phase on request) of the simulator
+// (docs/sim.md §6, §8).
 #pragma once
 
 #include <Eigen/Core>
@@ -31,6 +32,34 @@ struct BlunderRecord {
   int id = 0;             ///< blunder event number (one event spans several epochs)
 };
 
+/// What happened to a carrier phase (slips.csv `kind`; docs/sim.md §8).
+enum class CarrierEventKind {
+  kLossOfLock,     ///< the carrier is tracked again after a loss of lock: LLI bit 0, a new ambiguity
+  kSlipFlagged,    ///< an integer cycle slip with LLI bit 0 set
+  kSlipUnflagged,  ///< an integer cycle slip the receiver does not flag
+  kHalfCycle,      ///< half-cycle ambiguity after a (re-)acquisition: phase off by +-0.5 cycle while LLI bit 1 is set
+};
+/// slips.csv name of a kind: loss_of_lock | slip_flagged | slip_unflagged | half_cycle.
+const char* carrier_event_name(CarrierEventKind kind);
+
+/// One carrier-phase event (a row of slips.csv).
+struct CarrierEvent {
+  GpsTime t;          ///< epoch tag (GPST receiver time) of the first observation affected
+  bool rover = true;  ///< rover or base receiver
+  gnss::SatId sat;
+  CarrierEventKind kind = CarrierEventKind::kSlipFlagged;
+  double cycles = 0.0;  ///< phase jump [cycles]: ambiguity change (loss of lock, slips) or +-0.5 (half cycle)
+};
+
+/// The truth behind one written carrier phase observation (in memory only; the tests' oracle).
+struct CarrierTruth {
+  GpsTime t;  ///< epoch tag (GPST receiver time)
+  bool rover = true;
+  gnss::SatId sat;
+  double ambiguity_cycles = 0.0;  ///< integer ambiguity N in effect, slips included [cycles]
+  double half_cycle = 0.0;        ///< half-cycle offset in the written phase (0 or +-0.5) [cycles]
+};
+
 /// True receiver clock at one epoch tag.
 struct ClockTruth {
   GpsTime t;
@@ -47,7 +76,14 @@ struct GnssSimulation {
   int blunder_events = 0;
   long rover_sat_epochs = 0;       ///< tracked rover satellite-epochs (the blunder-rate denominator)
   std::vector<ClockTruth> clocks;  ///< every epoch tag
+  std::vector<CarrierEvent> carrier_events;  ///< slips.csv (empty unless carrier_phase), in time order
+  std::vector<CarrierTruth> carrier_truth;   ///< one per written phase (rover and base), in time order
 };
+
+/// Truth atmosphere of the simulated signals (docs/sim.md §6): I = kIonoTruthFactor x Klobuchar, T = kTropoTruthFactor
+/// x Saastamoinen, so that undifferenced processing with the broadcast models keeps a model error.
+inline constexpr double kIonoTruthFactor = 1.3;
+inline constexpr double kTropoTruthFactor = 1.05;
 
 /// DLL thermal code noise [m] at C/N0 [dB-Hz] (Kaplan & Hegarty 2006 eq. 7.88, coherent early-minus-late
 /// discriminator): sigma = chip * sqrt(B d / (2 cn0) * (1 + 2 / ((2 - d) T cn0))).
@@ -56,6 +92,16 @@ double thermal_code_sigma_m(const GnssOptions& options, double cn0_dbhz);
 double multipath_sigma_m(const GnssOptions& options, double cn0_dbhz);
 /// Range-rate noise [m/s] at C/N0: doppler_sigma_mps * 10^(max(0, ref - cn0) / 20).
 double doppler_sigma_mps(const GnssOptions& options, double cn0_dbhz);
+
+/// PLL thermal phase noise [cycles] at C/N0 [dB-Hz] (Kaplan & Hegarty 2006 ch. 5, PLL thermal noise jitter; docs/sim.md
+/// eq. 8.3): sigma = 1/(2 pi) sqrt(B_L / cn0 (1 + 1 / (2 T cn0))), B_L = pll_bandwidth_hz, T = pll_integration_time_s.
+double pll_phase_sigma_cycles(const GnssOptions& options, double cn0_dbhz);
+/// Carrier multipath sigma [m] at C/N0: carrier_multipath_sigma_m * 10^(max(0, ref - cn0) / 20), at most lambda/12
+/// (3 sigma within the single-reflection bound lambda/4; docs/sim.md eq. 8.4).
+double carrier_multipath_sigma_m(const GnssOptions& options, double cn0_dbhz);
+/// Cycle-slip rate [1/s] at C/N0 (docs/sim.md eq. 8.5): carrier_slip_rate_per_s * 10^(-(cn0 - threshold) / decade_db)
+/// with threshold = carrier_tracking_threshold_dbhz.
+double carrier_slip_rate_per_s(const GnssOptions& options, double cn0_dbhz);
 
 /// The code/Doppler weight model of docs/gnss.md eq. W1 that describes this receiver's simulated noise (what a user
 /// would configure from the receiver's data sheet; `pednav montecarlo --receiver-weights`, docs/consistency.md §3.8).

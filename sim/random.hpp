@@ -76,6 +76,8 @@ enum StreamId : uint64_t {
   kStreamClocks = 6,
   kStreamBlunders = 7,
   kStreamAtmosphere = 8,
+  kStreamCarrierRover = 9,  ///< carrier phase of the rover: ambiguities, PLL noise, multipath, slips (docs/sim.md §8)
+  kStreamCarrierBase = 10,  ///< the same for the base
 };
 
 /// First-order Gauss-Markov process with unit steady-state variance, sampled at steps dt_s (exact

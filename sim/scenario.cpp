@@ -51,6 +51,21 @@ std::vector<std::string> Scenario::problems() const {
   range(gnss.blunder_rate, 0.0, 0.5, "gnss.blunder_rate");
   if (gnss.blunder_max_m < gnss.blunder_min_m) p.push_back("gnss.blunder_max_m must be >= gnss.blunder_min_m");
   if (gnss.blunder_max_s < gnss.blunder_min_s) p.push_back("gnss.blunder_max_s must be >= gnss.blunder_min_s");
+  range(gnss.atmosphere_sd_iono_fraction, 0.0, 1.0, "gnss.atmosphere_sd_iono_fraction");
+  range(gnss.carrier_tracking_threshold_dbhz, 0.0, 60.0, "gnss.carrier_tracking_threshold_dbhz");
+  if (gnss.carrier_acquisition_threshold_dbhz < gnss.carrier_tracking_threshold_dbhz)
+    p.push_back("gnss.carrier_acquisition_threshold_dbhz must be >= gnss.carrier_tracking_threshold_dbhz");
+  range(gnss.pll_bandwidth_hz, 0.0, 50.0, "gnss.pll_bandwidth_hz");
+  range(gnss.pll_integration_time_s, 0.001, 0.1, "gnss.pll_integration_time_s");
+  range(gnss.carrier_multipath_sigma_m, 0.0, 0.1, "gnss.carrier_multipath_sigma_m");
+  range(gnss.carrier_multipath_tau_s, 0.01, 1e5, "gnss.carrier_multipath_tau_s");
+  range(gnss.carrier_ambiguity_max_cycles, 0, 10000000, "gnss.carrier_ambiguity_max_cycles");
+  range(gnss.carrier_slip_rate_per_s, 0.0, 10.0, "gnss.carrier_slip_rate_per_s");
+  range(gnss.carrier_slip_decade_db, 0.1, 60.0, "gnss.carrier_slip_decade_db");
+  range(gnss.carrier_slip_max_cycles, 1, 1000000, "gnss.carrier_slip_max_cycles");
+  range(gnss.carrier_slip_flagged_fraction, 0.0, 1.0, "gnss.carrier_slip_flagged_fraction");
+  range(gnss.carrier_half_cycle_probability, 0.0, 1.0, "gnss.carrier_half_cycle_probability");
+  range(gnss.carrier_half_cycle_s, 0.001, 3600.0, "gnss.carrier_half_cycle_s");
   for (size_t i = 0; i < gnss.attenuation.size(); ++i) {
     const auto& s = gnss.attenuation[i];
     const std::string k = "gnss.attenuation[" + std::to_string(i) + "]";

@@ -107,6 +107,22 @@ struct GnssOptions {
   double blunder_rate = 0.0;         ///< probability per rover satellite-epoch that a blunder starts [-]
   double blunder_min_m = 20.0, blunder_max_m = 100.0;  ///< magnitude range [m], random sign
   double blunder_min_s = 1.0, blunder_max_s = 5.0;     ///< duration range [s]
+  // L1 carrier phase (docs/sim.md §8). Off: the observation files carry code, Doppler and C/N0 only, as before.
+  bool carrier_phase = false;  ///< write L1C (cycles) with LLI into rover.obs/base.obs, slips into slips.csv
+  double atmosphere_sd_iono_fraction = 0.75;         ///< share of the residual SD atmosphere that is ionospheric [-]
+  double carrier_tracking_threshold_dbhz = 28.0;     ///< the PLL loses lock below this [dB-Hz]
+  double carrier_acquisition_threshold_dbhz = 30.0;  ///< a lost carrier locks again only above this [dB-Hz]
+  double pll_bandwidth_hz = 10.0;                    ///< PLL noise bandwidth B_L [Hz] (0: no thermal phase noise)
+  double pll_integration_time_s = 0.02;              ///< PLL predetection integration time T [s]
+  double carrier_multipath_sigma_m = 0.005;          ///< carrier multipath at C/N0 >= multipath_cn0_ref_dbhz [m]
+  double carrier_multipath_tau_s = 10.0;             ///< its Gauss-Markov correlation time [s]
+  int carrier_ambiguity_max_cycles = 1000000;        ///< ambiguities are uniform integers in [-max, max] [cycles]
+  double carrier_slip_rate_per_s = 0.01;        ///< cycle slips per second at carrier_tracking_threshold_dbhz [1/s]
+  double carrier_slip_decade_db = 6.0;          ///< the slip rate falls tenfold every this many dB above it [dB]
+  int carrier_slip_max_cycles = 10;             ///< slip size uniform in 1..max cycles, random sign
+  double carrier_slip_flagged_fraction = 0.7;   ///< share of the slips that the receiver flags (LLI bit 0) [-]
+  double carrier_half_cycle_probability = 0.2;  ///< per (re-)acquisition: half-cycle ambiguity (LLI bit 1)
+  double carrier_half_cycle_s = 3.0;            ///< how long the half-cycle offset and its flag last [s]
 };
 
 /// Everything one simulation needs.

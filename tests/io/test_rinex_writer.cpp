@@ -14,7 +14,7 @@
 namespace pednav {
 namespace {
 
-constexpr double kTolObsField = 0.6e-3;   // F14.3 rounding [m, Hz, dB-Hz]
+constexpr double kTolObsField = 0.6e-3;   // F14.3 rounding [m, Hz, dB-Hz, cycles]
 constexpr double kTolDoppler_hz = 1e-3;   // F14.3 rounding + RTKLIB keeps Doppler as a float (|D| < 5 kHz: 3e-4)
 constexpr double kTolSatPos_m = 1e-6;     // nav values are pre-rounded to the RINEX digits: identical states
 
@@ -74,6 +74,49 @@ TEST_F(RinexReadBack, NavigationReadsBackWithIdenticalGeometry) {
   }
   EXPECT_LT(worst_m, kTolSatPos_m);
   EXPECT_LT(worst_clock_s, 1e-15);
+}
+
+// Carrier phase (docs/sim.md §8): L1C in cycles and its loss-of-lock indicator read back through RTKLIB; a phase the
+// receiver did not track stays absent (blank field) while its code, Doppler and C/N0 are read.
+TEST(RinexWriter, CarrierPhaseAndLliReadBackThroughRtklib) {
+  auto f = test::scenario_from_text(test::kOpenSkyGnssYaml);
+  f.scenario.gnss.carrier_phase = true;
+  f.scenario.gnss.carrier_half_cycle_probability = 0.5;
+  f.scenario.gnss.attenuation.push_back({40.0, 1e5, "foliage", 5.0, 22.0, 8.0});  // losses of lock
+  auto s = sim::simulate(f.scenario);
+  ASSERT_TRUE(s.has_value());
+  const std::string dir = test::temp_dir("rinex_writer_carrier");
+  ASSERT_TRUE(io::write_rinex_obs(dir + "/rover.obs", s->gnss.rover, {}).has_value());
+  auto obs = gnss::read_rinex_obs(dir + "/rover.obs", {});
+  ASSERT_TRUE(obs.has_value()) << (obs ? "" : obs.error().message);
+  const auto& want = s->gnss.rover;
+  ASSERT_EQ(obs->epochs.size(), want.epochs.size());
+  long phases = 0, blanks = 0, lli_loss = 0, lli_half = 0;
+  double worst_cycles = 0.0;
+  for (size_t i = 0; i < want.epochs.size(); ++i) {
+    const auto &a = obs->epochs[i], &b = want.epochs[i];
+    ASSERT_EQ(a.sats.size(), b.sats.size());
+    for (size_t j = 0; j < b.sats.size(); ++j) {
+      const auto &x = a.sats[j], &y = b.sats[j];
+      EXPECT_NEAR(x.pseudorange_m, y.pseudorange_m, kTolObsField);
+      ASSERT_EQ(std::isfinite(x.carrier_cycles), std::isfinite(y.carrier_cycles));
+      EXPECT_EQ(x.wavelength_m, y.wavelength_m);
+      if (!std::isfinite(y.carrier_cycles)) {
+        ++blanks;
+        continue;
+      }
+      ++phases;
+      worst_cycles = std::max(worst_cycles, std::abs(x.carrier_cycles - y.carrier_cycles));
+      EXPECT_EQ(x.lli, y.lli);
+      lli_loss += (y.lli & 1) ? 1 : 0;
+      lli_half += (y.lli & 2) ? 1 : 0;
+    }
+  }
+  EXPECT_LT(worst_cycles, kTolObsField);
+  EXPECT_GT(phases, 1000);
+  EXPECT_GT(blanks, 100);
+  EXPECT_GT(lli_loss, 10);
+  EXPECT_GT(lli_half, 10);
 }
 
 TEST(RinexWriter, EmptyInputIsAnError) {
