@@ -43,6 +43,28 @@ Eigen::MatrixXd dd_operator(const std::vector<AmbiguityCandidate>& c, const std:
 
 }  // namespace
 
+const char* solution_status_name(SolutionStatus s) {
+  switch (s) {
+    case SolutionStatus::kFixed: return "fixed";
+    case SolutionStatus::kFloat: return "float";
+    case SolutionStatus::kCode: return "code";
+    case SolutionStatus::kIns: return "ins";
+    case SolutionStatus::kNone: break;
+  }
+  return "none";
+}
+
+int pos_quality(SolutionStatus s) {
+  switch (s) {
+    case SolutionStatus::kFixed: return 1;
+    case SolutionStatus::kFloat: return 2;
+    case SolutionStatus::kCode: return 5;
+    case SolutionStatus::kIns: return 5;
+    case SolutionStatus::kNone: break;
+  }
+  return 0;
+}
+
 AmbiguityFix resolve_ambiguities(const Eigen::VectorXd& x, const Eigen::MatrixXd& P,
                                  const std::vector<AmbiguityCandidate>& candidates, const AmbiguityOptions& o) {
   AmbiguityFix out;

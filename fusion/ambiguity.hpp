@@ -14,6 +14,12 @@
 
 namespace pednav::fusion {
 
+/// Solution status of an epoch (solution.csv `solution_status`, .pos Q: 1 fixed, 2 float, 5 code).
+enum class SolutionStatus : int { kNone = 0, kFixed, kFloat, kCode, kIns };
+const char* solution_status_name(SolutionStatus s);
+/// RTKLIB .pos Q of a status (1 fixed, 2 float, 5 code, single or INS-only; 0 none).
+int pos_quality(SolutionStatus s);
+
 /// Ambiguity-resolution options (config `gnss.ambiguity`, docs/carrier.md §3).
 struct AmbiguityOptions {
   double ratio_threshold = 3.0;          ///< second-best / best squared norm must reach this

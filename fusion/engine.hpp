@@ -15,7 +15,9 @@
 #include <vector>
 
 #include "core/expected.hpp"
+#include "fusion/ambiguity.hpp"
 #include "fusion/step_velocity.hpp"
+#include "gnss/carrier.hpp"
 #include "gnss/measurement.hpp"
 #include "gnss/types.hpp"
 #include "ins/error_state.hpp"
@@ -132,6 +134,15 @@ struct EngineOptions {
   int fault_window_epochs = 0;
   double max_base_age_s = 30.0;
   std::optional<Eigen::Vector3d> base_position_e;  ///< SD when set and base epochs are given
+  /// SD L1 carrier phase after each SD code/Doppler update (docs/carrier.md §8): one SD ambiguity state per
+  /// satellite in `ambiguity_slots` slots; integers resolved and validated as in `ambiguity`, then constraining the
+  /// filter. false: code and Doppler only (the outputs of pednav 0.2).
+  bool carrier = false;
+  double carrier_sigma_zenith_m = 0.003;      ///< one receiver's phase σ at zenith, C/N0 ≥ cn0_ref [m] (eq. 1.3)
+  double carrier_base_age_sigma_mps = 0.003;  ///< phase noise per second of base age [m/s]
+  int ambiguity_slots = 12;               ///< satellites with phase at once (kMaxErrorDim bounds the total)
+  gnss::DopplerSlipOptions carrier_slip;
+  AmbiguityOptions ambiguity;
   // Output.
   double output_rate_hz = 1.0;
   /// RTS smoothing of the whole run (docs/fusion.md §12): EngineResult::smoothed at the output epochs.
@@ -168,6 +179,11 @@ struct EpochOutput {
   double sd_yaw_rad = 0.0;
   int n_sats_used = 0, n_sats_rejected = 0;
   bool zupt = false;
+  /// With EngineOptions::carrier (docs/carrier.md §6): SolutionStatus of the epoch (fixed, float, code, ins: the last
+  /// GNSS epoch's when it is at most 1.5 s old, else ins), the double differences fixed there and their ratio.
+  int solution_status = 0;
+  int n_fixed_ambiguities = 0;
+  double ar_ratio = 0.0;
 };
 
 /// The IMU errors the forward filter ended with (body axes), their σ, and for the scale factors the total the
@@ -202,6 +218,13 @@ struct EngineSummary {
   long gnss_epochs_masked = 0;
   long clock_resets = 0;
   long multipath_resets = 0;         ///< multipath states (re)started: a satellite took a slot or returned after a gap
+  /// Carrier phase (EngineOptions::carrier, docs/carrier.md §6): summary.json `carrier`.
+  struct Carrier {
+    long epochs_with_phase = 0, fix_attempts = 0, fixes_rejected_by_validation = 0, wrong_fix_detections = 0;
+    long holds = 0, no_free_slot = 0;
+    std::array<long, static_cast<int>(gnss::SlipReason::kCount)> slips{};
+    std::map<std::string, long> not_fixed;
+  } carrier;
   std::map<std::string, long> code_used_rejected;     ///< "used", "fault", "low_cn0", "no_ephemeris", ...
   std::map<std::string, long> doppler_used_rejected;
   std::string initialization;        ///< how the state was initialized and when

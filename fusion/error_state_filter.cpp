@@ -79,6 +79,15 @@ ErrorStateFilter::ErrorStateFilter(const EngineOptions& o, int n_clocks) : o_(o)
       mp_sat_.assign(o.multipath_slots, gnss::SatId{});
       mp_last_ns_.assign(o.multipath_slots, kNeverNs);
     }
+    if (o.carrier && o.ambiguity_slots > 0) {
+      auto b = layout_.add("ambiguity", o.ambiguity_slots);
+      if (!b) {
+        problem_ = b.error().message;
+        return;
+      }
+      amb_block_ = *b;
+      amb_value_.assign(o.ambiguity_slots, 0.0);
+    }
   }
   // The g-sensitive gyro error (docs/error_state.md §5) when the spec gives its σ; after the GNSS blocks, so that
   // the errors-in-variables footprints of tc (kept on the leading INS block) do not carry it.
@@ -122,6 +131,10 @@ void ErrorStateFilter::init(const ins::NavState& nav, const ins::ImuErrors& imu,
   P_.block<3, 3>(ins::kAtt.offset, ins::kAtt.offset) = Ren * att_n * Ren.transpose();
   for (const auto& b : clock_blocks_) P_(b.offset, b.offset) = 1e12;  // unknown until the first GNSS epoch
   if (o_.mode == Mode::kTightlyCoupled) P_(drift_block_.offset, drift_block_.offset) = 1e6;
+  for (int i = 0; i < amb_block_.dim; ++i) {  // no satellite yet (also at a re-initialization)
+    P_(amb_block_.offset + i, amb_block_.offset + i) = 1.0;
+    amb_value_[i] = 0.0;
+  }
   for (int i = 0; i < mp_block_.dim; ++i) {  // unit-variance GM, no satellite yet (also at a re-initialization)
     P_(mp_block_.offset + i, mp_block_.offset + i) = 1.0;
     mp_value_[i] = 0.0;
@@ -215,6 +228,7 @@ void ErrorStateFilter::apply(const ErrorVector& dx) {
   for (size_t i = 0; i < clock_blocks_.size(); ++i) clock_m_[i] += dx(clock_blocks_[i].offset);
   if (o_.mode == Mode::kTightlyCoupled) drift_mps_ += dx(drift_block_.offset);
   for (int i = 0; i < mp_block_.dim; ++i) mp_value_[i] += dx(mp_block_.offset + i);
+  for (int i = 0; i < amb_block_.dim; ++i) amb_value_[i] += dx(amb_block_.offset + i);
 }
 
 int ErrorStateFilter::multipath_slot(const gnss::SatId& sat, int64_t t_ns, bool& reset) {

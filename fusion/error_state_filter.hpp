@@ -110,6 +110,11 @@ class ErrorStateFilter {
   int multipath_index(int slot) const { return mp_block_.offset + slot; }
   double multipath_value(int slot) const { return mp_value_[slot]; }
   bool has_multipath() const { return mp_block_.dim > 0; }
+  /// SD carrier-phase ambiguity slots [cycles] (EngineOptions::carrier, docs/carrier.md §8): the first state, the
+  /// number of slots, and each slot's nominal value (closed loop: the updates add their correction to it).
+  int ambiguity_offset() const { return amb_block_.offset; }
+  int ambiguity_slots() const { return amb_block_.dim; }
+  double& ambiguity_value(int slot) { return amb_value_[slot]; }
 
   // P <- J P J^T with J = I except the (velocity, attitude) block = A (docs/fusion.md eq. 5.9).
   void reexpress_velocity_attitude(const Eigen::Matrix3d& A);
@@ -176,6 +181,8 @@ class ErrorStateFilter {
   int g_sens_offset_ = -1;  // g-sensitivity block (docs/error_state.md §5), −1 without it
   ConsiderStates consider_;  // states the updates never correct (Schmidt–Kalman): the g-sensitivity block
   std::vector<double> mp_value_;
+  ins::Block amb_block_{0, 0};    // carrier-phase ambiguity slots (random constants: Φ = 1, no process noise)
+  std::vector<double> amb_value_;
   std::vector<gnss::SatId> mp_sat_;
   std::vector<int64_t> mp_last_ns_;
   RowTransition<ins::kMaxErrorDim> Phi_rows_;  // Φ of the current step by its row structure

@@ -24,6 +24,7 @@ constexpr double kInsFilterSigmaYawRad = 0.1 * 3.14159265358979323846 / 180.0;
 // Re-initialization from a GNSS epoch solution after divergence (tc mode): at most this many per run; the attitude is
 // the last healthy stance attitude, its heading may be off (wide σ), the walker's velocity is unknown.
 constexpr int kMaxReinitializations = 5;
+constexpr double kStatusMaxAge_s = 1.5;  // a GNSS epoch's carrier status holds for this long (docs/carrier.md §6)
 constexpr double kReinitSigmaYawRad = 30.0 * 3.14159265358979323846 / 180.0;
 constexpr double kReinitSigmaVelMps = 2.0;
 constexpr double kReinitSigmaPosM = 10.0;  // an epoch least-squares position (single epoch, possibly undifferenced)
@@ -188,6 +189,16 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
     if (output_now) {
       while (next_out_ns <= inc.t1.ns()) next_out_ns += out_period_ns;
       result.epochs.push_back(output(f.x(), f.P(), inc.t1, stance, last_used, last_rejected));
+      if (o_.carrier) {
+        // The status of the last GNSS epoch while it is recent (docs/carrier.md §6), else the INS carries it.
+        EpochOutput& e = result.epochs.back();
+        const CarrierEpoch& c = gnss_.last_carrier();
+        const bool recent = inc.t1 - gnss_.last_carrier_time() <= kStatusMaxAge_s;
+        e.solution_status = static_cast<int>(!recent ? SolutionStatus::kIns
+                                             : c.status ? static_cast<SolutionStatus>(c.status) : SolutionStatus::kCode);
+        e.n_fixed_ambiguities = recent ? c.n_fixed : 0;
+        e.ar_ratio = recent ? c.ratio : 0.0;
+      }
       last_used = last_rejected = 0;
       if (smooth && !reinitialized_at) {
         if (segment_open) {
@@ -322,6 +333,9 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
       const ins::InsState xs = ins::boxplus(nominal_at_output[k], dx, f.layout());
       const EpochOutput& fwd = result.epochs[k];
       result.smoothed[k] = output(xs, P, fwd.t, fwd.zupt, fwd.n_sats_used, fwd.n_sats_rejected);
+      result.smoothed[k].solution_status = fwd.solution_status;  // smoothed epochs carry the forward status
+      result.smoothed[k].n_fixed_ambiguities = fwd.n_fixed_ambiguities;
+      result.smoothed[k].ar_ratio = fwd.ar_ratio;
       if (finite && (!xs.nav.p_eb_e.allFinite() || !P.allFinite())) {
         finite = false;
         bad = k;

@@ -43,6 +43,7 @@ GnssEpochUpdater::GnssEpochUpdater(const EngineInputs& in, const EngineOptions& 
     for (const auto& e : *in.base) bt.push_back(e.time);
     matches_ = gnss::match_base_epochs(rt, bt, o.max_base_age_s);
     sd_ = true;
+    if (o.carrier) carrier_.emplace(in.nav, in.base, o);
   }
   // Per-epoch buffers sized once for the largest epoch (no reallocation on the per-epoch path).
   size_t max_sats = 0;
@@ -98,6 +99,8 @@ void GnssEpochUpdater::update(ErrorStateFilter& f, size_t gi, GpsTime t_proc, co
       return;
     }
   }
+  if (carrier_) carrier_->screen_rover(re);
+  last_carrier_ = CarrierEpoch{};
   const gnss::ObsEpoch* be = nullptr;
   std::optional<gnss::ObsEpoch> propagated;
   // No base epoch within max_base_age_s (a base that stopped): the epoch is processed undifferenced. The clock states
@@ -133,6 +136,7 @@ void GnssEpochUpdater::update(ErrorStateFilter& f, size_t gi, GpsTime t_proc, co
   const Geodetic llh = geodetic_from_ecef(p_a);
   std::vector<GnssRow>& rows = rows_;
   rows.clear();
+  code_sigma_.clear();
   std::vector<std::vector<double>>& code_res_by_slot = code_res_by_slot_;
   code_res_by_slot.resize(o_.systems.size());
   for (auto& v : code_res_by_slot) v.clear();
@@ -208,6 +212,7 @@ void GnssEpochUpdater::update(ErrorStateFilter& f, size_t gi, GpsTime t_proc, co
       }
     }
     code_res_by_slot[slot].push_back(rc.residual);
+    if (carrier_) code_sigma_[so.sat] = rc.sigma;
     rows.push_back(rc);
     if (have_rate) {
       GnssRow rd;
@@ -280,6 +285,19 @@ void GnssEpochUpdater::update(ErrorStateFilter& f, size_t gi, GpsTime t_proc, co
   }
   if (updated) ++sum.gnss_epochs_used;
   faults_.record_history(rows);
+  if (carrier_ && sd && updated) {
+    // The phase rows at the state the code and Doppler left (sequential update; docs/carrier.md §8), the antenna
+    // moved back to the epoch as above.
+    const Vector3d p_imu2 = f.x().nav.p_eb_e - f.x().nav.v_eb_e * lag_s;
+    const Geodetic llh2 = geodetic_from_ecef(p_imu2);
+    const LeverArm arm2 = lever_arm_e(o_.lever_arm_n_m, o_.lever_arm_heading_m, R_e_n(llh2.lat, llh2.lon),
+                                      f.x().nav.R_e_b());
+    std::vector<int> clock_slot_of_system(static_cast<int>(gnss::System::kSbas) + 1, -1);
+    for (size_t k = 0; k < o_.systems.size(); ++k) clock_slot_of_system[static_cast<int>(o_.systems[k])] = static_cast<int>(k);
+    last_carrier_ = carrier_->update(f, re, *be, matches_[gi].base_index, std::abs(matches_[gi].age_s), p_imu2 + arm2.arm_e, arm2,
+                                     C_pos, clock_slot_of_system, code_sigma_, sum);
+    last_carrier_time_ = re.time;
+  }
   // Divergence watch: most code rows of a well-observed epoch rejected, epoch after epoch (kImplausibleEpochs).
   const int code_rows = static_cast<int>(std::count_if(rows.begin(), rows.end(), [](const GnssRow& w) { return !w.doppler; }));
   if (code_rows >= kImplausibleMinCodeRows && 2 * rejected_code > code_rows) ++implausible_streak_;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/time.hpp"
+#include "fusion/carrier_update.hpp"
 #include "fusion/engine.hpp"
 #include "fusion/error_state_filter.hpp"
 #include "fusion/fault_detection.hpp"
@@ -60,6 +61,9 @@ class GnssEpochUpdater {
   size_t row_capacity() const { return rows_.capacity(); }
   /// Capacity of the fault history (no allocation on the per-epoch path).
   void reserve_fault_history() { faults_.reserve(); }
+  /// The carrier-phase outcome of the last GNSS epoch (status 0 without carrier) and that epoch's time.
+  const CarrierEpoch& last_carrier() const { return last_carrier_; }
+  GpsTime last_carrier_time() const { return last_carrier_time_; }
 
  private:
   const EngineInputs& in_;
@@ -75,6 +79,10 @@ class GnssEpochUpdater {
   std::vector<std::vector<double>> code_res_by_slot_;
   std::vector<double> doppler_res_;
   std::vector<int> active_;
+  std::optional<CarrierUpdater> carrier_;  // EngineOptions::carrier with a base (docs/carrier.md §8)
+  CarrierEpoch last_carrier_;
+  GpsTime last_carrier_time_;
+  std::map<gnss::SatId, double> code_sigma_;  // this epoch's code σ per satellite with a code row
 };
 
 }  // namespace pednav::fusion

@@ -37,28 +37,6 @@ int slot_of(const std::vector<gnss::System>& systems, gnss::System s) {
 
 }  // namespace
 
-const char* solution_status_name(SolutionStatus s) {
-  switch (s) {
-    case SolutionStatus::kFixed: return "fixed";
-    case SolutionStatus::kFloat: return "float";
-    case SolutionStatus::kCode: return "code";
-    case SolutionStatus::kIns: return "ins";
-    case SolutionStatus::kNone: break;
-  }
-  return "none";
-}
-
-int pos_quality(SolutionStatus s) {
-  switch (s) {
-    case SolutionStatus::kFixed: return 1;
-    case SolutionStatus::kFloat: return 2;
-    case SolutionStatus::kCode: return 5;
-    case SolutionStatus::kIns: return 5;
-    case SolutionStatus::kNone: break;
-  }
-  return 0;
-}
-
 // One linearised row of the epoch: SD code, SD Doppler or SD phase.
 struct RtkFilter::Row {
   enum Kind { kCode, kDoppler, kPhase } kind = kCode;

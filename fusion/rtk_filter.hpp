@@ -21,12 +21,6 @@
 
 namespace pednav::fusion {
 
-/// Solution status of an epoch (solution.csv `solution_status`, .pos Q: 1 fixed, 2 float, 5 code).
-enum class SolutionStatus : int { kNone = 0, kFixed, kFloat, kCode, kIns };
-const char* solution_status_name(SolutionStatus s);
-/// RTKLIB .pos Q of a status (1 fixed, 2 float, 5 code/single; 0 none).
-int pos_quality(SolutionStatus s);
-
 struct RtkOptions {
   std::vector<gnss::System> systems{gnss::System::kGps};
   double elevation_mask_rad = 15.0 * kDegToRad;

@@ -34,6 +34,7 @@ ObsEpoch propagate_base_with_doppler(const ObsEpoch& base, GpsTime t) {
     if (std::isnan(s.doppler_hz) || std::isnan(s.pseudorange_m)) continue;
     SatObs p = s;
     p.pseudorange_m = s.pseudorange_m - s.wavelength_m * s.doppler_hz * dt;
+    p.carrier_cycles = s.carrier_cycles - s.doppler_hz * dt;  // Φ̇ = −D (docs/carrier.md §5); NaN stays NaN
     out.sats.push_back(p);
   }
   return out;

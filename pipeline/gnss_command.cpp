@@ -216,18 +216,8 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
   std::vector<SolutionRow> rows;
   rows.reserve(rover->epochs.size());
   // Carrier phase (docs/carrier.md §4): with a base and L1 phase in both files, unless gnss.carrier: off.
-  auto has_phase = [](const gnss::ObsData& d) {
-    for (const auto& e : d.epochs) {
-      for (const auto& s : e.sats) {
-        if (std::isfinite(s.carrier_cycles)) return true;
-      }
-    }
-    return false;
-  };
   if (g.carrier != "off") {
-    if (!base) sum.carrier_note = "no base_obs (the carrier needs a base in pednav gnss)";
-    else if (!has_phase(*rover)) sum.carrier_note = g.rover_obs + " has no L1 carrier phase";
-    else if (!has_phase(*base)) sum.carrier_note = g.base_obs + " has no L1 carrier phase";
+    sum.carrier_note = carrier_unavailable(g, *rover, base ? &*base : nullptr);
     if (sum.carrier_note.empty()) {
       sum.carrier = true;
     } else if (g.carrier == "on") {
@@ -255,18 +245,7 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
     ro.base_age_sigma_mps = g.carrier_base_age_sigma_mps;
     ro.accel_sigma_horizontal_mps2 = g.rtk_accel_sigma_horizontal_mps2;
     ro.accel_sigma_vertical_mps2 = g.rtk_accel_sigma_vertical_mps2;
-    const auto& a = g.ambiguity;
-    ro.ar.ratio_threshold = a.ratio_threshold;
-    ro.ar.min_success_rate = a.min_success_rate;
-    ro.ar.ar_elevation_mask_rad = a.elevation_mask_deg * kDegToRad;
-    ro.ar.partial = a.partial;
-    ro.ar.min_ambiguities = a.min_ambiguities;
-    ro.ar.min_lock_epochs = a.min_lock_epochs;
-    ro.ar.hold = a.hold;
-    ro.ar.hold_min_epochs = a.hold_min_epochs;
-    ro.ar.hold_sigma_cycles = a.hold_sigma_cycles;
-    ro.ar.validation_w = a.validation_w;
-    ro.ar.glonass = a.glonass;
+    ro.ar = ambiguity_options(g);
     fusion::RtkFilter rtk(*nav, base->epochs, p_base, ro);
     Progress progress("gnss rtk", static_cast<int64_t>(rover->epochs.size()), progress_enabled());
     for (size_t i = 0; i < rover->epochs.size(); ++i) {

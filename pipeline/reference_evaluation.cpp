@@ -48,4 +48,36 @@ Expected<nlohmann::json> evaluate_rows(const std::vector<SolutionRow>& rows, con
                         {"inside_3sigma_pct", eval::consistency_statistics(ev->errors).inside_3sigma_pct}};
 }
 
+std::string carrier_unavailable(const GnssConfig& g, const gnss::ObsData& rover, const gnss::ObsData* base) {
+  auto has_phase = [](const gnss::ObsData& d) {
+    for (const auto& e : d.epochs) {
+      for (const auto& s : e.sats) {
+        if (std::isfinite(s.carrier_cycles)) return true;
+      }
+    }
+    return false;
+  };
+  if (!base) return "no base_obs (the carrier needs a base)";
+  if (!has_phase(rover)) return g.rover_obs + " has no L1 carrier phase";
+  if (!has_phase(*base)) return g.base_obs + " has no L1 carrier phase";
+  return "";
+}
+
+fusion::AmbiguityOptions ambiguity_options(const GnssConfig& g) {
+  const auto& a = g.ambiguity;
+  fusion::AmbiguityOptions o;
+  o.ratio_threshold = a.ratio_threshold;
+  o.min_success_rate = a.min_success_rate;
+  o.ar_elevation_mask_rad = a.elevation_mask_deg * kDegToRad;
+  o.partial = a.partial;
+  o.min_ambiguities = a.min_ambiguities;
+  o.min_lock_epochs = a.min_lock_epochs;
+  o.hold = a.hold;
+  o.hold_min_epochs = a.hold_min_epochs;
+  o.hold_sigma_cycles = a.hold_sigma_cycles;
+  o.validation_w = a.validation_w;
+  o.glonass = a.glonass;
+  return o;
+}
+
 }  // namespace pednav::pipeline

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // Evaluation of a command's solution rows against the configured reference (`reference:`), shared by `pednav run`
-// and `pednav gnss`: evaluation JSON written next to the outputs, and the figures for summary.json.
+// and `pednav gnss`: evaluation JSON written next to the outputs, and the figures for summary.json. Also the carrier
+// decisions both commands share.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -8,6 +9,8 @@
 #include <vector>
 
 #include "core/expected.hpp"
+#include "fusion/ambiguity.hpp"
+#include "gnss/types.hpp"
 #include "io/config.hpp"
 #include "io/solution_writer.hpp"
 #include "io/trajectory_io.hpp"
@@ -23,5 +26,11 @@ Expected<io::TrajectoryFile> read_configured_reference(const io::RunConfig& c);
 Expected<nlohmann::json> evaluate_rows(const std::vector<io::SolutionRow>& rows, const io::TrajectoryFile& reference,
                                        const std::string& reference_name, const std::string& csv_path,
                                        const std::string& json_path, const std::string& what);
+
+/// Why the L1 carrier cannot be used with these data (empty: it can): no base, or no phase in the rover or base file.
+std::string carrier_unavailable(const io::GnssConfig& g, const gnss::ObsData& rover, const gnss::ObsData* base);
+
+/// The `gnss.ambiguity` section as the engine's options.
+fusion::AmbiguityOptions ambiguity_options(const io::GnssConfig& g);
 
 }  // namespace pednav::pipeline

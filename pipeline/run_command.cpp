@@ -83,7 +83,51 @@ SolutionRow solution_row(const fusion::EpochOutput& e) {
   r.n_sats_rejected = e.n_sats_rejected;
   r.zupt = e.zupt;
   r.pos_quality = e.n_sats_used > 0 ? 4 : 5;
+  if (e.solution_status != 0) {  // with carrier (docs/carrier.md §6)
+    const auto st = static_cast<fusion::SolutionStatus>(e.solution_status);
+    r.solution_status = fusion::solution_status_name(st);
+    r.pos_quality = fusion::pos_quality(st);
+    r.n_fixed_ambiguities = e.n_fixed_ambiguities;
+    r.ar_ratio = e.ar_ratio;
+  }
   return r;
+}
+
+// summary.json `carrier` (docs/carrier.md §6): output epochs by status, fix rate, time to first fix, the re-fix time
+// after each span without a fixed epoch of at least 10 s, and the filter's counters.
+static nlohmann::json carrier_json(const fusion::EngineSummary& sum, const std::vector<fusion::EpochOutput>& epochs) {
+  nlohmann::json c;
+  std::map<std::string, long> by_status;
+  std::optional<GpsTime> first, first_fix, last_fix;
+  std::vector<double> refix;
+  for (const auto& e : epochs) {
+    const auto st = static_cast<fusion::SolutionStatus>(e.solution_status);
+    ++by_status[fusion::solution_status_name(st)];
+    if (!first) first = e.t;
+    if (st != fusion::SolutionStatus::kFixed) continue;
+    if (!first_fix) first_fix = e.t;
+    if (last_fix && e.t - *last_fix >= 10.0) refix.push_back(e.t - *last_fix);
+    last_fix = e.t;
+  }
+  c["used"] = true;
+  c["output_epochs_by_status"] = by_status;
+  c["fix_rate_pct"] = epochs.empty() ? 0.0 : 100.0 * by_status["fixed"] / static_cast<double>(epochs.size());
+  c["time_to_first_fix_s"] = first_fix ? nlohmann::json(*first_fix - *first) : nlohmann::json(nullptr);
+  c["gaps_between_fixed_epochs_s"] = refix;
+  const auto& k = sum.carrier;
+  c["gnss_epochs_with_phase"] = k.epochs_with_phase;
+  c["fix_attempts"] = k.fix_attempts;
+  c["not_fixed"] = k.not_fixed;
+  c["fixes_rejected_by_validation"] = k.fixes_rejected_by_validation;
+  c["wrong_fix_detections"] = k.wrong_fix_detections;
+  c["integer_constraints"] = k.holds;
+  c["phase_without_free_slot"] = k.no_free_slot;
+  nlohmann::json slips;
+  for (int i = 0; i < static_cast<int>(gnss::SlipReason::kCount); ++i) {
+    slips[gnss::slip_reason_name(static_cast<gnss::SlipReason>(i))] = k.slips[i];
+  }
+  c["slips"] = slips;
+  return c;
 }
 
 fusion::EngineOptions engine_options(const RunConfig& c) {
@@ -153,6 +197,10 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.multipath_cn0_ref_dbhz = c.multipath.cn0_ref_dbhz;
   o.multipath_slots = c.multipath.slots;
   o.multipath_reset_gap_s = c.multipath.reset_gap_s;
+  // Carrier phase: decided in load_run_inputs from the configuration and the data (gnss.carrier auto|on|off).
+  o.carrier_sigma_zenith_m = c.gnss.carrier_sigma_zenith_m;
+  o.carrier_base_age_sigma_mps = c.gnss.carrier_base_age_sigma_mps;
+  o.ambiguity = ambiguity_options(c.gnss);
   const ImuErrorModelChoice m = imu_error_model_choice(c);
   o.estimate_scale_factors = m.scale_states;
   o.estimate_gyro_scale_factors = m.gyro_scale_states;
@@ -233,6 +281,13 @@ Expected<RunInputs> load_run_inputs(const RunConfig& c) {
     } else {
       return make_error(c.gnss.base_obs + ": no base position (set base_position_ecef_m)");
     }
+  }
+  // The tight coupling uses the carrier with gnss.carrier: on only; auto keeps it to pednav gnss until the tc phase
+  // rows beat the code-only filter on the shared logs (docs/carrier.md §8, docs/results.md "Carrier phase").
+  if (c.gnss.carrier == "on") {
+    const std::string why_not = carrier_unavailable(c.gnss, *d.rover, d.base ? &*d.base : nullptr);
+    if (!why_not.empty()) return make_error(c.source_file + ": gnss.carrier: on, but " + why_not);
+    d.options.carrier = true;
   }
   return d;
 }
@@ -399,6 +454,7 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
                  {"events", sum.health_events}};
   for (const auto& e : sum.health_events) spdlog::warn("{}", e);
   j["accounting"] = accounting_json(*imu, data, sum, opt.mode == fusion::Mode::kTightlyCoupled);
+  if (opt.carrier) j["carrier"] = carrier_json(sum, res->epochs);
   j["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   if (!c.reference.file.empty()) {
