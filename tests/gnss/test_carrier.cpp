@@ -128,6 +128,39 @@ TEST(PhaseSlipScreen, SmallSlipBelowThresholdIsNotFlagged) {
   EXPECT_FALSE(s.screen(e)[0].has_value());
 }
 
+TEST(PhaseSlipScreen, MillionCycleJumpOfOneSatelliteIsASlip) {
+  PhaseSlipScreen s;
+  s.screen(epoch_at(0));
+  ObsEpoch e = epoch_at(1);
+  e.sats[1].carrier_cycles += 1e6;
+  const auto r = s.screen(e);
+  ASSERT_TRUE(r[1].has_value());
+  EXPECT_EQ(*r[1], SlipReason::kDoppler);
+  EXPECT_FALSE(r[0].has_value());
+  EXPECT_FALSE(r[2].has_value());
+}
+
+TEST(PhaseSlipScreen, LossOfLockOnEveryEpochIsASlipEveryEpoch) {
+  PhaseSlipScreen s;
+  int slips = 0;
+  for (int t = 0; t < 10; ++t) {
+    ObsEpoch e = epoch_at(t);
+    for (auto& x : e.sats) x.lli = kLliSlip;
+    for (const auto& r : s.screen(e)) slips += r.has_value();
+  }
+  EXPECT_EQ(slips, 3 * 9);  // every satellite at every epoch after its first
+}
+
+TEST(PhaseSlipScreen, SatelliteThatComesAndGoesWithinTheGapKeepsItsArc) {
+  // Present on even epochs only (2-s gaps < max_gap_s): the phase still follows the Doppler, no slip.
+  PhaseSlipScreen s;
+  for (int t = 0; t < 10; ++t) {
+    ObsEpoch e = epoch_at(t);
+    if (t % 2) e.sats.erase(e.sats.begin());
+    for (const auto& r : s.screen(e)) EXPECT_FALSE(r.has_value()) << "epoch " << t;
+  }
+}
+
 TEST(PhaseSlipScreen, ReceiverClockStepIsNotASlip) {
   // A 1-ms receiver clock step moves every phase by c·1 ms / λ ≈ 1.6e6 cycles and no Doppler: removed by the median.
   PhaseSlipScreen s;

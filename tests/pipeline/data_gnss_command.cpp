@@ -206,18 +206,8 @@ TEST(GnssCommandData, GalwayAgainstCorsGlw1) {
   expect_measured(s, kGalwayGlw1, "galway GLW1");
 }
 
-TEST(GnssCommandData, SpirentDynamicNoiseFree) {
-  const std::string d = shared_data("rtklib_samples/instinct_spirent_rtk_GE/");
-  PEDNAV_REQUIRE_DATA(d + "Rover-dynamic_PVA_Spirent.csv");
-  const std::string yaml = "mode: gnss\nrover_obs: " + d + "iono-Klob_tropo-Saast/Rover-dynamic_MO_Spirent.obs\n" +
-                           "base_obs: " + d + "iono-Klob_tropo-Saast/Base-static_MO_Spirent.obs\nnav: [" + d +
-                           "RINEX_GN_Spirent.23N, " + d + "RINEX_EN_Spirent.23L]\n" +
-                           "base_position_ecef_m: [4157177.06580187, 671230.476590636, 4774767.03105544]\n" +
-                           "gnss:\n  carrier: off\n  systems: [G, E]\n";
-  auto sum = run(yaml, "spirent");
-  ASSERT_TRUE(sum) << sum.error().message;
-  EXPECT_EQ(sum->epochs_solved, 601);
-  // Truth at 10 Hz: GpsToW -> ECEF (columns 3..6).
+// Spirent truth at 10 Hz: round(GpsToW · 10) -> ECEF (columns 3..6 of the PVA file in folder d).
+std::map<long, Eigen::Vector3d> spirent_truth(const std::string& d) {
   std::map<long, Eigen::Vector3d> truth;
   std::ifstream in(d + "Rover-dynamic_PVA_Spirent.csv");
   std::string line;
@@ -229,6 +219,21 @@ TEST(GnssCommandData, SpirentDynamicNoiseFree) {
     while (std::getline(ss, cell, ',')) c.push_back(std::stod(cell));
     truth[std::lround(c[3] * 10)] = Eigen::Vector3d(c[4], c[5], c[6]);
   }
+  return truth;
+}
+
+TEST(GnssCommandData, SpirentDynamicNoiseFree) {
+  const std::string d = shared_data("rtklib_samples/instinct_spirent_rtk_GE/");
+  PEDNAV_REQUIRE_DATA(d + "Rover-dynamic_PVA_Spirent.csv");
+  const std::string yaml = "mode: gnss\nrover_obs: " + d + "iono-Klob_tropo-Saast/Rover-dynamic_MO_Spirent.obs\n" +
+                           "base_obs: " + d + "iono-Klob_tropo-Saast/Base-static_MO_Spirent.obs\nnav: [" + d +
+                           "RINEX_GN_Spirent.23N, " + d + "RINEX_EN_Spirent.23L]\n" +
+                           "base_position_ecef_m: [4157177.06580187, 671230.476590636, 4774767.03105544]\n" +
+                           "gnss:\n  carrier: off\n  systems: [G, E]\n";
+  auto sum = run(yaml, "spirent");
+  ASSERT_TRUE(sum) << sum.error().message;
+  EXPECT_EQ(sum->epochs_solved, 601);
+  const std::map<long, Eigen::Vector3d> truth = spirent_truth(d);
   std::vector<double> e;
   for (const auto& r : read_gnss_csv(out_dir("spirent") + "/gnss.csv")) {
     auto it = truth.find(std::lround(r.tow_s * 10));
@@ -432,17 +437,7 @@ TEST(GnssRtkData, SpirentDynamicFixesEveryEpochAfterTheFirstFix) {
   auto sum = run(yaml, "spirent_rtk");
   ASSERT_TRUE(sum) << sum.error().message;
   ASSERT_TRUE(sum->carrier);
-  std::map<long, Eigen::Vector3d> truth;
-  std::ifstream in(d + "Rover-dynamic_PVA_Spirent.csv");
-  std::string line;
-  std::getline(in, line);
-  while (std::getline(in, line)) {
-    std::vector<double> c;
-    std::stringstream ss(line);
-    std::string cell;
-    while (std::getline(ss, cell, ',')) c.push_back(std::stod(cell));
-    truth[std::lround(c[3] * 10)] = Eigen::Vector3d(c[4], c[5], c[6]);
-  }
+  const std::map<long, Eigen::Vector3d> truth = spirent_truth(d);
   const auto s = rtk::score(out_dir("spirent_rtk") + "/gnss.csv", truth, [](double tow) { return std::lround(tow * 10); });
   std::printf("[spirent rtk] fixed %d of %d, horizontal RMS on fixed %.5f m, ttff %.0f s\n", s.fixed, s.epochs,
               s.on_fixed.rms, sum->rtk.time_to_first_fix_s.value_or(-1));
