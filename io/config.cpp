@@ -8,6 +8,7 @@
 #include <memory>
 #include <sstream>
 
+#include "io/trajectory_io.hpp"
 #include "io/yaml_schema.hpp"
 
 namespace pednav::io {
@@ -35,15 +36,7 @@ Expected<RunConfig> parse_run_config(const std::string& yaml_text, const std::st
       YamlMap ref = top.map("reference");
       ref.path("file", cfg.reference.file, top.has("reference"));
       ref.choice("format", cfg.reference.format, {"csv", "pos", "nmea"});
-      std::vector<double> q;
-      ref.numbers("nmea_qualities", q);
-      for (double v : q) {
-        if (v < 1 || v > 9 || v != static_cast<int>(v)) {
-          ref.problem("nmea_qualities", "GGA fix qualities are integers 1-9");
-          break;
-        }
-        cfg.reference.nmea_qualities.push_back(static_cast<int>(v));
-      }
+      ref.integers("nmea_qualities", cfg.reference.nmea_qualities, kMinGgaQuality, kMaxGgaQuality);
     }
     {
       YamlMap out = top.map("output");

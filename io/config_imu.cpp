@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -23,21 +24,16 @@ std::string joined_names(const std::vector<std::string>& v) {
   return s;
 }
 
+constexpr int kMaxColumn = 10000;  // 0-based column indices of the IMU CSV (also time.column, stance.column)
+
 void read_columns(YamlMap& m, const char* key, std::array<int, 3>& out) {
-  std::vector<double> v;
-  m.numbers(key, v);
-  if (v.empty()) return;
+  std::vector<int> v;
+  if (!m.integers(key, v, 0, kMaxColumn) || v.empty()) return;  // a bad index is reported with the range
   if (v.size() != 3) {
     m.problem(key, "expected 3 column indices, got " + std::to_string(v.size()));
     return;
   }
-  for (int i = 0; i < 3; ++i) {
-    if (v[i] < 0 || v[i] != std::floor(v[i])) {
-      m.problem(key, "column indices are 0-based non-negative integers");
-      return;
-    }
-    out[i] = static_cast<int>(v[i]);
-  }
+  std::copy(v.begin(), v.end(), out.begin());
 }
 
 }  // namespace
@@ -57,7 +53,7 @@ void read_imu_format(YamlMap& m, ImuFormat& out) {
   {
     YamlMap t = m.map("time");
     t.choice("base", out.time_base, {"gps_sow", "gpst_unix", "relative", "index"});
-    t.integer("column", out.time_column, false, 0, 10000);
+    t.integer("column", out.time_column, false, 0, kMaxColumn);
     std::string unit = "s";
     t.choice("unit", unit, {"s", "ms", "us", "ns"});
     out.time_scale_s = unit == "s" ? 1.0 : unit == "ms" ? 1e-3 : unit == "us" ? 1e-6 : 1e-9;
@@ -92,7 +88,7 @@ void read_imu_format(YamlMap& m, ImuFormat& out) {
   }
   if (m.has("stance")) {
     YamlMap st = m.map("stance");
-    st.integer("column", out.stance_column, true, 0, 10000);
+    st.integer("column", out.stance_column, true, 0, kMaxColumn);
   }
   if (m.has("mag")) {
     YamlMap mg = m.map("mag");

@@ -454,5 +454,21 @@ TEST(Config, InitialSectionRoundTrips) {
   EXPECT_FALSE(yaw_again->initial.heading_from_magnetometer);
 }
 
+// Integer keys take whole numbers inside their range; anything else is named with its key path (never cast).
+TEST(Config, IntegerKeysAreRangeChecked) {
+  auto big = parse(
+      "mode: gnss\nrover_obs: r\nnav: n\nfault_rejection: {window_epochs: 1e71}\n"
+      "multipath: {slots: 2.5}\n");
+  ASSERT_FALSE(big);
+  EXPECT_THAT(big.error().message, HasSubstr("cfg.yaml:4: fault_rejection.window_epochs: value 1e71 is out of range"));
+  EXPECT_THAT(big.error().message, HasSubstr("cfg.yaml:5: multipath.slots: expected an integer, got '2.5'"));
+  auto list = parse("mode: gnss\nrover_obs: r\nnav: n\nreference: {file: ref.nmea, nmea_qualities: 4}\n");
+  ASSERT_FALSE(list);
+  EXPECT_THAT(list.error().message, HasSubstr("reference.nmea_qualities: expected a list of integers, got '4'"));
+  auto ok = parse("mode: gnss\nrover_obs: r\nnav: n\nreference: {file: ref.nmea, nmea_qualities: [4, 5]}\n");
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_EQ(ok->reference.nmea_qualities, (std::vector<int>{4, 5}));
+}
+
 }  // namespace
 }  // namespace pednav::io
