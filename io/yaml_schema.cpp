@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-2-Clause
 #include "io/yaml_schema.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -30,6 +32,18 @@ bool parse_double(const YAML::Node& n, double& out) {
 }
 
 }  // namespace
+
+std::string yaml_number(double v) {
+  if (std::isnan(v)) return ".nan";
+  if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
+  return fmt::format("{}", v);  // fmt's shortest round-trip form (Dragonbox)
+}
+
+std::vector<std::string> yaml_numbers(std::initializer_list<double> v) {
+  std::vector<std::string> out;
+  for (double x : v) out.push_back(yaml_number(x));
+  return out;
+}
 
 Expected<YamlSource> read_yaml_source(const std::string& path, const std::string& what) {
   std::ifstream in(path);

@@ -25,6 +25,12 @@ struct YamlSource {
 /// Read a whole YAML file; the error is "<path>: cannot open <what>" (what: "configuration file", ...).
 Expected<YamlSource> read_yaml_source(const std::string& path, const std::string& what);
 
+/// A double as YAML text: the shortest decimal that reads back to the same double ("0.1", where yaml-cpp's emitter
+/// writes 0.10000000000000001); .inf, -.inf, .nan for the others. Emit it as a scalar: `e << yaml_number(v)`.
+std::string yaml_number(double v);
+/// The same for a list (a flow sequence of numbers: `e << YAML::Flow << yaml_numbers({x, y, z})`).
+std::vector<std::string> yaml_numbers(std::initializer_list<double> v);
+
 /// Problems found while reading one YAML file.
 struct YamlProblems {
   std::string file;
