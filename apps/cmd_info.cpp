@@ -8,6 +8,7 @@
 #include "apps/commands.hpp"
 #include "io/config.hpp"
 #include "io/rinex_summary.hpp"
+#include "pipeline/run_command.hpp"
 
 namespace pednav::apps {
 
@@ -22,8 +23,11 @@ void add_config_check_command(CLI::App& app, Action& action) {
         spdlog::error("{}", cfg.error().message);
         return 1;
       }
-      if (const auto missing = io::missing_input_files(*cfg); !missing.empty()) {
-        for (const auto& m : missing) spdlog::error("{}: {}", *path, m);
+      // What `pednav run` would reject before reading data, then the files it would not find: all at once.
+      auto problems = pipeline::run_config_problems(*cfg);
+      for (const auto& m : io::missing_input_files(*cfg)) problems.push_back(m);
+      if (!problems.empty()) {
+        for (const auto& m : problems) spdlog::error("{}: {}", *path, m);
         return 1;
       }
       std::fputs(io::to_yaml(*cfg).c_str(), stdout);

@@ -8,6 +8,7 @@
 #include <memory>
 #include <sstream>
 
+#include "io/trajectory_io.hpp"
 #include "io/yaml_schema.hpp"
 
 namespace pednav::io {
@@ -35,15 +36,7 @@ Expected<RunConfig> parse_run_config(const std::string& yaml_text, const std::st
       YamlMap ref = top.map("reference");
       ref.path("file", cfg.reference.file, top.has("reference"));
       ref.choice("format", cfg.reference.format, {"csv", "pos", "nmea"});
-      std::vector<double> q;
-      ref.numbers("nmea_qualities", q);
-      for (double v : q) {
-        if (v < 1 || v > 9 || v != static_cast<int>(v)) {
-          ref.problem("nmea_qualities", "GGA fix qualities are integers 1-9");
-          break;
-        }
-        cfg.reference.nmea_qualities.push_back(static_cast<int>(v));
-      }
+      ref.integers("nmea_qualities", cfg.reference.nmea_qualities, kMinGgaQuality, kMaxGgaQuality);
     }
     {
       YamlMap out = top.map("output");
@@ -97,47 +90,53 @@ std::string to_yaml(const RunConfig& c) {
   if (!c.gnss.nav.empty()) e << YAML::Key << "nav" << YAML::Value << c.gnss.nav;
   if (c.gnss.base_position_ecef_m) {
     const auto& b = *c.gnss.base_position_ecef_m;
-    e << YAML::Key << "base_position_ecef_m" << YAML::Value << YAML::Flow << std::vector<double>{b.x(), b.y(), b.z()};
+    e << YAML::Key << "base_position_ecef_m" << YAML::Value << YAML::Flow << yaml_numbers({b.x(), b.y(), b.z()});
   }
   e << YAML::Key << "gnss" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "systems" << YAML::Value << YAML::Flow << c.gnss.systems;
-  e << YAML::Key << "elevation_mask_deg" << YAML::Value << c.gnss.elevation_mask_rad * 180.0 / 3.14159265358979323846;
-  e << YAML::Key << "epoch_match_tolerance_s" << YAML::Value << c.gnss.epoch_match_tolerance_s;
-  e << YAML::Key << "max_base_age_s" << YAML::Value << c.gnss.max_base_age_s;
-  e << YAML::Key << "min_cn0_dbhz" << YAML::Value << c.gnss.min_cn0_dbhz;
+  e << YAML::Key << "elevation_mask_deg" << YAML::Value
+    << yaml_number(c.gnss.elevation_mask_rad * 180.0 / 3.14159265358979323846);
+  e << YAML::Key << "epoch_match_tolerance_s" << YAML::Value << yaml_number(c.gnss.epoch_match_tolerance_s);
+  e << YAML::Key << "max_base_age_s" << YAML::Value << yaml_number(c.gnss.max_base_age_s);
+  e << YAML::Key << "min_cn0_dbhz" << YAML::Value << yaml_number(c.gnss.min_cn0_dbhz);
   e << YAML::Key << "base_propagation" << YAML::Value << c.gnss.base_propagation;
-  e << YAML::Key << "code_sigma_zenith_m" << YAML::Value << c.gnss.code_sigma_zenith_m;
-  e << YAML::Key << "doppler_sigma_zenith_mps" << YAML::Value << c.gnss.doppler_sigma_zenith_mps;
-  e << YAML::Key << "cn0_ref_dbhz" << YAML::Value << c.gnss.cn0_ref_dbhz;
-  e << YAML::Key << "glonass_code_factor" << YAML::Value << c.gnss.glonass_code_factor;
-  e << YAML::Key << "elevation_weight" << YAML::Value << c.gnss.elevation_weight;
-  e << YAML::Key << "code_squaring_loss" << YAML::Value << c.gnss.code_squaring_loss;
-  e << YAML::Key << "code_smoothing_s" << YAML::Value << c.gnss.code_smoothing_s;
+  e << YAML::Key << "code_sigma_zenith_m" << YAML::Value << yaml_number(c.gnss.code_sigma_zenith_m);
+  e << YAML::Key << "doppler_sigma_zenith_mps" << YAML::Value << yaml_number(c.gnss.doppler_sigma_zenith_mps);
+  e << YAML::Key << "cn0_ref_dbhz" << YAML::Value << yaml_number(c.gnss.cn0_ref_dbhz);
+  e << YAML::Key << "glonass_code_factor" << YAML::Value << yaml_number(c.gnss.glonass_code_factor);
+  e << YAML::Key << "elevation_weight" << YAML::Value << yaml_number(c.gnss.elevation_weight);
+  e << YAML::Key << "code_squaring_loss" << YAML::Value << yaml_number(c.gnss.code_squaring_loss);
+  e << YAML::Key << "code_smoothing_s" << YAML::Value << yaml_number(c.gnss.code_smoothing_s);
   e << YAML::Key << "carrier" << YAML::Value << c.gnss.carrier;
-  e << YAML::Key << "carrier_sigma_zenith_m" << YAML::Value << c.gnss.carrier_sigma_zenith_m;
-  e << YAML::Key << "carrier_base_age_sigma_mps" << YAML::Value << c.gnss.carrier_base_age_sigma_mps;
-  e << YAML::Key << "rtk_accel_sigma_horizontal_mps2" << YAML::Value << c.gnss.rtk_accel_sigma_horizontal_mps2;
-  e << YAML::Key << "rtk_accel_sigma_vertical_mps2" << YAML::Value << c.gnss.rtk_accel_sigma_vertical_mps2;
+  e << YAML::Key << "carrier_sigma_zenith_m" << YAML::Value << yaml_number(c.gnss.carrier_sigma_zenith_m);
+  e << YAML::Key << "carrier_base_age_sigma_mps" << YAML::Value << yaml_number(c.gnss.carrier_base_age_sigma_mps);
+  e << YAML::Key << "rtk_accel_sigma_horizontal_mps2" << YAML::Value << yaml_number(c.gnss.rtk_accel_sigma_horizontal_mps2);
+  e << YAML::Key << "rtk_accel_sigma_vertical_mps2" << YAML::Value << yaml_number(c.gnss.rtk_accel_sigma_vertical_mps2);
   {
     const auto& a = c.gnss.ambiguity;
     e << YAML::Key << "ambiguity" << YAML::Value << YAML::BeginMap;
-    e << YAML::Key << "ratio_threshold" << YAML::Value << a.ratio_threshold;
-    e << YAML::Key << "min_success_rate" << YAML::Value << a.min_success_rate;
-    e << YAML::Key << "elevation_mask_deg" << YAML::Value << a.elevation_mask_deg;
+    e << YAML::Key << "ratio_threshold" << YAML::Value << yaml_number(a.ratio_threshold);
+    e << YAML::Key << "min_success_rate" << YAML::Value << yaml_number(a.min_success_rate);
+    e << YAML::Key << "elevation_mask_deg" << YAML::Value << yaml_number(a.elevation_mask_deg);
     e << YAML::Key << "partial" << YAML::Value << a.partial;
     e << YAML::Key << "min_ambiguities" << YAML::Value << a.min_ambiguities;
     e << YAML::Key << "min_lock_epochs" << YAML::Value << a.min_lock_epochs;
     e << YAML::Key << "hold" << YAML::Value << a.hold;
     e << YAML::Key << "hold_min_epochs" << YAML::Value << a.hold_min_epochs;
-    e << YAML::Key << "hold_sigma_cycles" << YAML::Value << a.hold_sigma_cycles;
-    e << YAML::Key << "validation_w" << YAML::Value << a.validation_w;
+    e << YAML::Key << "hold_sigma_cycles" << YAML::Value << yaml_number(a.hold_sigma_cycles);
+    e << YAML::Key << "validation_w" << YAML::Value << yaml_number(a.validation_w);
     e << YAML::Key << "glonass" << YAML::Value << a.glonass;
     e << YAML::EndMap;
   }
   e << YAML::EndMap;
   if (!c.imu.file.empty()) {
     e << YAML::Key << "imu" << YAML::Value << YAML::BeginMap << YAML::Key << "file" << YAML::Value << c.imu.file;
-    if (!c.imu.format_preset.empty()) e << YAML::Key << "format" << YAML::Value << c.imu.format_preset;
+    if (!c.imu.format_preset.empty()) {
+      e << YAML::Key << "format" << YAML::Value << c.imu.format_preset;
+    } else if (c.imu.has_format) {
+      e << YAML::Key << "format" << YAML::Value;
+      emit_imu_format(e, c.imu.format);
+    }
     if (c.imu.spec_auto) {
       e << YAML::Key << "spec" << YAML::Value << "auto";
     } else if (!c.imu.spec_preset.empty() || c.imu.spec.name == "inline") {
@@ -154,50 +153,52 @@ std::string to_yaml(const RunConfig& c) {
     }
     e << YAML::EndMap;
   }
+  const Eigen::Vector3d& l = c.antenna.lever_arm_ned_m;
+  const Eigen::Vector3d& lh = c.antenna.lever_arm_heading_m;
   e << YAML::Key << "antenna" << YAML::Value << YAML::BeginMap << YAML::Key << "lever_arm_ned_m" << YAML::Value
-    << YAML::Flow << YAML::BeginSeq << c.antenna.lever_arm_ned_m.x() << c.antenna.lever_arm_ned_m.y()
-    << c.antenna.lever_arm_ned_m.z() << YAML::EndSeq << YAML::Key << "lever_arm_heading_m" << YAML::Value << YAML::Flow
-    << YAML::BeginSeq << c.antenna.lever_arm_heading_m.x() << c.antenna.lever_arm_heading_m.y()
-    << c.antenna.lever_arm_heading_m.z() << YAML::EndSeq << YAML::Key << "sigma_horizontal_m" << YAML::Value
-    << c.antenna.sigma_horizontal_m << YAML::Key << "sigma_vertical_m" << YAML::Value << c.antenna.sigma_vertical_m
-    << YAML::Key << "velocity_model" << YAML::Value << c.antenna.velocity_model << YAML::Key
-    << "velocity_sigma_horizontal_mps" << YAML::Value << c.antenna.velocity_sigma_horizontal_mps << YAML::Key
-    << "velocity_sigma_vertical_mps" << YAML::Value << c.antenna.velocity_sigma_vertical_mps << YAML::Key
-    << "stride_velocity_sigma_horizontal_mps" << YAML::Value << c.antenna.stride_velocity_sigma_horizontal_mps
-    << YAML::Key << "stride_velocity_sigma_vertical_mps" << YAML::Value
-    << c.antenna.stride_velocity_sigma_vertical_mps << YAML::EndMap;
+    << YAML::Flow << yaml_numbers({l.x(), l.y(), l.z()}) << YAML::Key << "lever_arm_heading_m" << YAML::Value
+    << YAML::Flow << yaml_numbers({lh.x(), lh.y(), lh.z()}) << YAML::Key << "sigma_horizontal_m" << YAML::Value
+    << yaml_number(c.antenna.sigma_horizontal_m) << YAML::Key << "sigma_vertical_m" << YAML::Value
+    << yaml_number(c.antenna.sigma_vertical_m) << YAML::Key << "velocity_model" << YAML::Value
+    << c.antenna.velocity_model << YAML::Key << "velocity_sigma_horizontal_mps" << YAML::Value
+    << yaml_number(c.antenna.velocity_sigma_horizontal_mps) << YAML::Key << "velocity_sigma_vertical_mps" << YAML::Value
+    << yaml_number(c.antenna.velocity_sigma_vertical_mps) << YAML::Key << "stride_velocity_sigma_horizontal_mps"
+    << YAML::Value << yaml_number(c.antenna.stride_velocity_sigma_horizontal_mps) << YAML::Key
+    << "stride_velocity_sigma_vertical_mps" << YAML::Value << yaml_number(c.antenna.stride_velocity_sigma_vertical_mps)
+    << YAML::EndMap;
   {
     const InitialConfig& i = c.initial;
     constexpr double kDeg = 180.0 / 3.14159265358979323846;
     e << YAML::Key << "initial" << YAML::Value << YAML::BeginMap;
     if (i.position_e) {
       e << YAML::Key << "position_ecef_m" << YAML::Value << YAML::Flow
-        << std::vector<double>{i.position_e->x(), i.position_e->y(), i.position_e->z()};
+        << yaml_numbers({i.position_e->x(), i.position_e->y(), i.position_e->z()});
     }
-    if (i.yaw_rad) e << YAML::Key << "yaw_deg" << YAML::Value << *i.yaw_rad * kDeg;
+    if (i.yaw_rad) e << YAML::Key << "yaw_deg" << YAML::Value << yaml_number(*i.yaw_rad * kDeg);
     if (i.heading_from_magnetometer) {
       e << YAML::Key << "heading" << YAML::Value << "magnetometer" << YAML::Key << "declination_deg" << YAML::Value
-        << i.declination_rad * kDeg;
+        << yaml_number(i.declination_rad * kDeg);
     }
-    e << YAML::Key << "heading_init_distance_m" << YAML::Value << i.heading_init_distance_m << YAML::Key
-      << "sigma_position_m" << YAML::Value << i.sigma_position_m << YAML::Key << "sigma_velocity_mps" << YAML::Value
-      << i.sigma_velocity_mps << YAML::Key << "sigma_tilt_deg" << YAML::Value << i.sigma_tilt_rad * kDeg << YAML::Key
-      << "sigma_yaw_deg" << YAML::Value << i.sigma_yaw_rad * kDeg << YAML::EndMap;
+    e << YAML::Key << "heading_init_distance_m" << YAML::Value << yaml_number(i.heading_init_distance_m) << YAML::Key
+      << "sigma_position_m" << YAML::Value << yaml_number(i.sigma_position_m) << YAML::Key << "sigma_velocity_mps"
+      << YAML::Value << yaml_number(i.sigma_velocity_mps) << YAML::Key << "sigma_tilt_deg" << YAML::Value
+      << yaml_number(i.sigma_tilt_rad * kDeg) << YAML::Key << "sigma_yaw_deg" << YAML::Value
+      << yaml_number(i.sigma_yaw_rad * kDeg) << YAML::EndMap;
   }
-  e << YAML::Key << "mechanization_rate_hz" << YAML::Value << c.mechanization_rate_hz;
-  e << YAML::Key << "zupt" << YAML::Value << YAML::BeginMap << YAML::Key << "detector" << YAML::Value
-    << c.zupt.detector << YAML::Key << "form" << YAML::Value << c.zupt.form << YAML::Key << "edge_s" << YAML::Value
-    << c.zupt.edge_s << YAML::Key << "updates" << YAML::Value << c.zupt.updates << YAML::EndMap;
-  e << YAML::Key << "fault_rejection" << YAML::Value << YAML::BeginMap << YAML::Key << "probability"
-    << YAML::Value << c.fault_rejection_probability << YAML::Key << "window_epochs" << YAML::Value
+  e << YAML::Key << "mechanization_rate_hz" << YAML::Value << yaml_number(c.mechanization_rate_hz);
+  e << YAML::Key << "zupt" << YAML::Value << YAML::BeginMap << YAML::Key << "detector" << YAML::Value << c.zupt.detector
+    << YAML::Key << "form" << YAML::Value << c.zupt.form << YAML::Key << "edge_s" << YAML::Value
+    << yaml_number(c.zupt.edge_s) << YAML::Key << "updates" << YAML::Value << c.zupt.updates << YAML::EndMap;
+  e << YAML::Key << "fault_rejection" << YAML::Value << YAML::BeginMap << YAML::Key << "probability" << YAML::Value
+    << yaml_number(c.fault_rejection_probability) << YAML::Key << "window_epochs" << YAML::Value
     << c.fault_rejection_window_epochs << YAML::EndMap;
   e << YAML::Key << "smoother" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled" << YAML::Value
     << c.smoother_enabled << YAML::EndMap;
   e << YAML::Key << "multipath" << YAML::Value << YAML::BeginMap << YAML::Key << "states" << YAML::Value
-    << c.multipath.states << YAML::Key << "sigma_m" << YAML::Value << c.multipath.sigma_m << YAML::Key << "tau_s"
-    << YAML::Value << c.multipath.tau_s << YAML::Key << "cn0_ref_dbhz" << YAML::Value << c.multipath.cn0_ref_dbhz
-    << YAML::Key << "slots" << YAML::Value << c.multipath.slots << YAML::Key << "reset_gap_s" << YAML::Value
-    << c.multipath.reset_gap_s << YAML::EndMap;
+    << c.multipath.states << YAML::Key << "sigma_m" << YAML::Value << yaml_number(c.multipath.sigma_m) << YAML::Key
+    << "tau_s" << YAML::Value << yaml_number(c.multipath.tau_s) << YAML::Key << "cn0_ref_dbhz" << YAML::Value
+    << yaml_number(c.multipath.cn0_ref_dbhz) << YAML::Key << "slots" << YAML::Value << c.multipath.slots << YAML::Key
+    << "reset_gap_s" << YAML::Value << yaml_number(c.multipath.reset_gap_s) << YAML::EndMap;
   const ImuErrorModelChoice m = imu_error_model_choice(c);  // written resolved: what this run's filter used
   e << YAML::Key << "scale_factors" << YAML::Value << YAML::BeginMap << YAML::Key << "states" << YAML::Value
     << m.scale_states << YAML::Key << "gyro" << YAML::Value << c.scale_factors.gyro << YAML::Key
@@ -210,14 +211,16 @@ std::string to_yaml(const RunConfig& c) {
   {
     const fusion::StepVelocityOptions& sv = c.step_velocity;
     e << YAML::Key << "step_velocity" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled" << YAML::Value
-      << sv.enabled << YAML::Key << "leg_length_m" << YAML::Value << sv.leg_length_m << YAML::Key << "sigma_along_mps"
-      << YAML::Value << sv.sigma_along_mps << YAML::Key << "sigma_cross_mps" << YAML::Value << sv.sigma_cross_mps
-      << YAML::Key << "sigma_vertical_mps" << YAML::Value << sv.sigma_vertical_mps << YAML::Key << "min_step_s"
-      << YAML::Value << sv.min_step_s << YAML::Key << "max_step_s" << YAML::Value << sv.max_step_s << YAML::Key
-      << "min_rise_m" << YAML::Value << sv.min_rise_m << YAML::EndMap;
+      << sv.enabled << YAML::Key << "leg_length_m" << YAML::Value << yaml_number(sv.leg_length_m) << YAML::Key
+      << "sigma_along_mps" << YAML::Value << yaml_number(sv.sigma_along_mps) << YAML::Key << "sigma_cross_mps"
+      << YAML::Value << yaml_number(sv.sigma_cross_mps) << YAML::Key << "sigma_vertical_mps" << YAML::Value
+      << yaml_number(sv.sigma_vertical_mps) << YAML::Key << "min_step_s" << YAML::Value << yaml_number(sv.min_step_s)
+      << YAML::Key << "max_step_s" << YAML::Value << yaml_number(sv.max_step_s) << YAML::Key << "min_rise_m"
+      << YAML::Value << yaml_number(sv.min_rise_m) << YAML::EndMap;
   }
   e << YAML::Key << "output" << YAML::Value << YAML::BeginMap << YAML::Key << "rate_hz" << YAML::Value
-    << c.output.rate_hz << YAML::Key << "formats" << YAML::Value << YAML::Flow << c.output.formats << YAML::EndMap;
+    << yaml_number(c.output.rate_hz) << YAML::Key << "formats" << YAML::Value << YAML::Flow << c.output.formats
+    << YAML::EndMap;
   e << YAML::EndMap;
   return std::string(e.c_str()) + "\n";
 }

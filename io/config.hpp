@@ -280,6 +280,9 @@ void read_imu_spec_entry(YamlMap& m, const std::string& key, ins::ImuSpec& spec,
 /// The inverse of read_imu_spec_entry: the preset's name when `spec` is exactly the preset, else the map
 /// {preset: NAME, <every read_imu_spec key>} (config.resolved.yaml reads back to the same spec).
 void emit_imu_spec(YAML::Emitter& e, const ins::ImuSpec& spec, const std::string& preset);
+/// The inverse of read_imu_format: every key of an inline IMU column map (config.resolved.yaml reads back to the same
+/// format; the mounting as the angles it was read from, or as roll/pitch/yaw of R_b_s when that was set alone).
+void emit_imu_format(YAML::Emitter& e, const ImuFormat& format);
 /// `{preset: NAME, <only the keys whose value differs from the preset's>}` (a flow map for hand-written configs; reads
 /// back to the same spec up to the unit conversion's rounding).
 std::string imu_spec_flow_yaml(const ins::ImuSpec& spec, const std::string& preset);

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -23,21 +24,16 @@ std::string joined_names(const std::vector<std::string>& v) {
   return s;
 }
 
+constexpr int kMaxColumn = 10000;  // 0-based column indices of the IMU CSV (also time.column, stance.column)
+
 void read_columns(YamlMap& m, const char* key, std::array<int, 3>& out) {
-  std::vector<double> v;
-  m.numbers(key, v);
-  if (v.empty()) return;
+  std::vector<int> v;
+  if (!m.integers(key, v, 0, kMaxColumn) || v.empty()) return;  // a bad index is reported with the range
   if (v.size() != 3) {
     m.problem(key, "expected 3 column indices, got " + std::to_string(v.size()));
     return;
   }
-  for (int i = 0; i < 3; ++i) {
-    if (v[i] < 0 || v[i] != std::floor(v[i])) {
-      m.problem(key, "column indices are 0-based non-negative integers");
-      return;
-    }
-    out[i] = static_cast<int>(v[i]);
-  }
+  std::copy(v.begin(), v.end(), out.begin());
 }
 
 }  // namespace
@@ -57,7 +53,7 @@ void read_imu_format(YamlMap& m, ImuFormat& out) {
   {
     YamlMap t = m.map("time");
     t.choice("base", out.time_base, {"gps_sow", "gpst_unix", "relative", "index"});
-    t.integer("column", out.time_column, false, 0, 10000);
+    t.integer("column", out.time_column, false, 0, kMaxColumn);
     std::string unit = "s";
     t.choice("unit", unit, {"s", "ms", "us", "ns"});
     out.time_scale_s = unit == "s" ? 1.0 : unit == "ms" ? 1e-3 : unit == "us" ? 1e-6 : 1e-9;
@@ -92,7 +88,7 @@ void read_imu_format(YamlMap& m, ImuFormat& out) {
   }
   if (m.has("stance")) {
     YamlMap st = m.map("stance");
-    st.integer("column", out.stance_column, true, 0, 10000);
+    st.integer("column", out.stance_column, true, 0, kMaxColumn);
   }
   if (m.has("mag")) {
     YamlMap mg = m.map("mag");
@@ -114,6 +110,7 @@ void read_imu_format(YamlMap& m, ImuFormat& out) {
   if (m.has("mounting_rpy_deg")) {
     m.vector3("mounting_rpy_deg", rpy_deg);
     out.R_b_s = R_n_b_from_euler(rpy_deg.x() * kDegToRad, rpy_deg.y() * kDegToRad, rpy_deg.z() * kDegToRad);
+    out.mounting_rpy_deg = rpy_deg;
   } else {
     m.raw("mounting_rpy_deg");
   }
@@ -260,7 +257,62 @@ void emit_imu_spec(YAML::Emitter& e, const ins::ImuSpec& spec, const std::string
   }
   e << YAML::BeginMap;
   if (!preset.empty()) e << YAML::Key << "preset" << YAML::Value << preset;
-  for (const SpecKey& k : spec_keys()) e << YAML::Key << k.key << YAML::Value << spec.*k.field / k.factor;
+  for (const SpecKey& k : spec_keys()) e << YAML::Key << k.key << YAML::Value << yaml_number(spec.*k.field / k.factor);
+  e << YAML::EndMap;
+}
+
+void emit_imu_format(YAML::Emitter& e, const ImuFormat& f) {
+  auto unit_of_scale = [](double scale, std::initializer_list<std::pair<double, const char*>> units) {
+    for (const auto& [s, name] : units)
+      if (scale == s) return name;
+    return units.begin()->second;  // not reached: every scale the reader sets is listed
+  };
+  auto columns = [](const std::array<int, 3>& c) { return std::vector<int>(c.begin(), c.end()); };
+  auto signs = [](const Eigen::Vector3d& v) { return yaml_numbers({v.x(), v.y(), v.z()}); };
+  e << YAML::BeginMap;
+  e << YAML::Key << "delimiter" << YAML::Value
+    << (f.delimiter == '\t' ? std::string("tab") : std::string(1, f.delimiter));
+  e << YAML::Key << "header_lines" << YAML::Value << f.header_lines;
+  e << YAML::Key << "time" << YAML::Value << YAML::BeginMap << YAML::Key << "base" << YAML::Value << f.time_base;
+  e << YAML::Key << "column" << YAML::Value << f.time_column;
+  e << YAML::Key << "unit" << YAML::Value
+    << unit_of_scale(f.time_scale_s, {{1.0, "s"}, {1e-3, "ms"}, {1e-6, "us"}, {1e-9, "ns"}});
+  if (f.gps_week >= 0) e << YAML::Key << "gps_week" << YAML::Value << f.gps_week;
+  if (f.start_epoch) {
+    e << YAML::Key << "start_gps_week" << YAML::Value << f.start_epoch->week() << YAML::Key << "start_gps_tow_s"
+      << YAML::Value << yaml_number(f.start_epoch->tow_s());
+  }
+  if (f.index_rate_hz > 0) e << YAML::Key << "rate_hz" << YAML::Value << yaml_number(f.index_rate_hz);
+  e << YAML::EndMap;
+  e << YAML::Key << "gyro" << YAML::Value << YAML::BeginMap << YAML::Key << "columns" << YAML::Value << YAML::Flow
+    << columns(f.gyro_columns) << YAML::Key << "unit" << YAML::Value << f.gyro_unit << YAML::Key << "signs"
+    << YAML::Value << YAML::Flow << signs(f.gyro_signs) << YAML::Key << "full_scale_deg_per_s" << YAML::Value
+    << yaml_number(f.gyro_full_scale * kRadToDeg) << YAML::EndMap;
+  e << YAML::Key << "accel" << YAML::Value << YAML::BeginMap << YAML::Key << "columns" << YAML::Value << YAML::Flow
+    << columns(f.accel_columns) << YAML::Key << "unit" << YAML::Value << f.accel_unit << YAML::Key << "signs"
+    << YAML::Value << YAML::Flow << signs(f.accel_signs) << YAML::Key << "full_scale_g" << YAML::Value
+    << yaml_number(f.accel_full_scale / kG0) << YAML::EndMap;
+  if (f.stance_column >= 0) {
+    e << YAML::Key << "stance" << YAML::Value << YAML::BeginMap << YAML::Key << "column" << YAML::Value
+      << f.stance_column << YAML::EndMap;
+  }
+  if (f.mag_columns[0] >= 0) {
+    e << YAML::Key << "mag" << YAML::Value << YAML::BeginMap << YAML::Key << "columns" << YAML::Value << YAML::Flow
+      << columns(f.mag_columns) << YAML::Key << "unit" << YAML::Value
+      << unit_of_scale(f.mag_scale_to_ut, {{1.0, "ut"}, {100.0, "gauss"}, {0.1, "mgauss"}, {1e-3, "nt"}}) << YAML::Key
+      << "signs" << YAML::Value << YAML::Flow << signs(f.mag_signs) << YAML::EndMap;
+  }
+  if (!f.R_b_s.isIdentity(0.0)) {
+    // The angles as read when they give this R_b_s (a format built in code may set R_b_s alone).
+    const Eigen::Vector3d& a = f.mounting_rpy_deg;
+    const bool as_read = R_n_b_from_euler(a.x() * kDegToRad, a.y() * kDegToRad, a.z() * kDegToRad) == f.R_b_s;
+    const Eigen::Vector3d rpy_deg = as_read ? a : Eigen::Vector3d(euler_from_R_n_b(f.R_b_s) * kRadToDeg);
+    e << YAML::Key << "mounting_rpy_deg" << YAML::Value << YAML::Flow
+      << yaml_numbers({rpy_deg.x(), rpy_deg.y(), rpy_deg.z()});
+  }
+  e << YAML::Key << "max_gap_s" << YAML::Value << yaml_number(f.max_gap_s);
+  e << YAML::Key << "gap_factor" << YAML::Value << yaml_number(f.gap_factor);
+  e << YAML::Key << "rest_tolerance_mps2" << YAML::Value << yaml_number(f.rest_tolerance_mps2);
   e << YAML::EndMap;
 }
 

@@ -100,6 +100,7 @@ Expected<HmmModelFile> read_hmm_model(const std::string& path) {
       t.strings("logs", f.training.logs);
       double obs = 0;
       t.number("observations", obs, false, 0.0, 1e15);
+      if (obs != std::floor(obs)) t.problem("observations", "expected an integer (a count of observations)");
       f.training.observations = static_cast<long>(obs);
       t.integer("iterations", f.training.iterations, false, 0);
       t.boolean("converged", f.training.converged);

@@ -36,6 +36,7 @@ struct ImuFormat {
   std::string gyro_unit = "rad_per_s";  ///< rad_per_s | deg_per_s | rad | deg   (rad/deg = increments per sample)
   std::string accel_unit = "mps2";      ///< mps2 | g | mps                      (mps = increments per sample)
   Eigen::Matrix3d R_b_s = Eigen::Matrix3d::Identity();  ///< mounting: sensor axes -> IMU body frame
+  Eigen::Vector3d mounting_rpy_deg = Eigen::Vector3d::Zero();  ///< the angles R_b_s was read from [deg] (written back)
   /// Optional stance-label column (0 = moving, 1 = stance; e.g. reference or oracle zero-velocity labels), read
   /// into ImuLog::stance for `zupt.detector: labels`; -1 = none.
   int stance_column = -1;

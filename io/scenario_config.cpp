@@ -104,7 +104,7 @@ Expected<ScenarioFile> parse_scenario(const std::string& yaml_text, const std::s
   out.source_file = source_name;
   sim::Scenario& sc = out.scenario;
   std::string track_file, track_format = "auto";
-  std::vector<double> track_qualities;
+  std::vector<int> track_qualities;
   std::string track_date;
   double track_start_offset_s = 0.0;
   std::vector<std::pair<size_t, Geodetic>> geodetic_wp;  // (waypoint index, position): ENU once the origin is known
@@ -205,7 +205,7 @@ Expected<ScenarioFile> parse_scenario(const std::string& yaml_text, const std::s
       YamlMap t = top.map("track");
       t.path("file", track_file, true);
       t.choice("format", track_format, {"auto", "csv", "pos", "nmea"});
-      t.numbers("nmea_qualities", track_qualities);
+      t.integers("nmea_qualities", track_qualities, kMinGgaQuality, kMaxGgaQuality);
       t.text("nmea_date", track_date);
       t.number("start_offset_s", track_start_offset_s, false, 0.0, 86400.0);
       RealGnssFiles real;
@@ -305,7 +305,7 @@ Expected<ScenarioFile> parse_scenario(const std::string& yaml_text, const std::s
   if (!track_file.empty()) {
     TrajectoryReadOptions ro;
     if (auto f = parse_trajectory_format(track_format)) ro.format = *f;
-    for (double q : track_qualities) ro.nmea_qualities.insert(static_cast<int>(q));
+    ro.nmea_qualities.insert(track_qualities.begin(), track_qualities.end());
     ro.nmea_date = track_date;
     auto tf = read_trajectory(track_file, ro);
     if (!tf) return make_error(source_name + ": track.file: " + tf.error().message);

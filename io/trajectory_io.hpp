@@ -12,6 +12,9 @@ namespace pednav::io {
 
 enum class TrajectoryFormat { kAuto, kCsv, kPos, kNmea };
 
+/// GGA fix qualities a configuration may ask for (0 is "invalid", never kept).
+inline constexpr int kMinGgaQuality = 1, kMaxGgaQuality = 9;
+
 struct TrajectoryReadOptions {
   TrajectoryFormat format = TrajectoryFormat::kAuto;
   std::set<int> nmea_qualities;  ///< GGA fix qualities to keep (empty: every valid fix, quality >= 1)

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-2-Clause
 #include "io/yaml_schema.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -30,6 +32,18 @@ bool parse_double(const YAML::Node& n, double& out) {
 }
 
 }  // namespace
+
+std::string yaml_number(double v) {
+  if (std::isnan(v)) return ".nan";
+  if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
+  return fmt::format("{}", v);  // fmt's shortest round-trip form (Dragonbox)
+}
+
+std::vector<std::string> yaml_numbers(std::initializer_list<double> v) {
+  std::vector<std::string> out;
+  for (double x : v) out.push_back(yaml_number(x));
+  return out;
+}
 
 Expected<YamlSource> read_yaml_source(const std::string& path, const std::string& what) {
   std::ifstream in(path);
@@ -101,20 +115,47 @@ void YamlMap::number(const std::string& key, double& out, bool required, double 
   out = v;
 }
 
-void YamlMap::integer(const std::string& key, int& out, bool required, int min, int max) {
-  const YAML::Node n = get(key, required);
-  if (absent(n)) return;
+bool YamlMap::integer_of(const YAML::Node& n, const std::string& key, int min, int max, int& out) {
   double v = 0.0;
-  if (!parse_double(n, v) || v != std::floor(v) || std::abs(v) > 2e9) {
+  if (!parse_double(n, v) || v != std::floor(v)) {
     problems_->add(n, key_path(key), "expected an integer, got " + describe(n));
-    return;
+    return false;
   }
+  // Compared as a double: only a value inside [min, max] is converted (a double beyond int is undefined behaviour).
   if (v < min || v > max) {
     problems_->add(n, key_path(key),
                    "value " + n.Scalar() + " is out of range [" + std::to_string(min) + ", " + std::to_string(max) + "]");
-    return;
+    return false;
   }
   out = static_cast<int>(v);
+  return true;
+}
+
+void YamlMap::integer(const std::string& key, int& out, bool required, int min, int max) {
+  const YAML::Node n = get(key, required);
+  if (absent(n)) return;
+  int v = 0;
+  if (integer_of(n, key, min, max, v)) out = v;
+}
+
+bool YamlMap::integers(const std::string& key, std::vector<int>& out, int min, int max, bool required) {
+  const YAML::Node n = get(key, required);
+  if (absent(n)) return !required;
+  if (!n.IsSequence()) {
+    problems_->add(n, key_path(key), "expected a list of integers, got " + describe(n));
+    return false;
+  }
+  out.clear();
+  bool ok = true;
+  for (const auto& item : n) {
+    int v = 0;
+    if (integer_of(item, key, min, max, v)) {
+      out.push_back(v);
+    } else {
+      ok = false;
+    }
+  }
+  return ok;
 }
 
 void YamlMap::boolean(const std::string& key, bool& out, bool required) {

@@ -25,6 +25,12 @@ struct YamlSource {
 /// Read a whole YAML file; the error is "<path>: cannot open <what>" (what: "configuration file", ...).
 Expected<YamlSource> read_yaml_source(const std::string& path, const std::string& what);
 
+/// A double as YAML text: the shortest decimal that reads back to the same double ("0.1", where yaml-cpp's emitter
+/// writes 0.10000000000000001); .inf, -.inf, .nan for the others. Emit it as a scalar: `e << yaml_number(v)`.
+std::string yaml_number(double v);
+/// The same for a list (a flow sequence of numbers: `e << YAML::Flow << yaml_numbers({x, y, z})`).
+std::vector<std::string> yaml_numbers(std::initializer_list<double> v);
+
 /// Problems found while reading one YAML file.
 struct YamlProblems {
   std::string file;
@@ -50,7 +56,10 @@ class YamlMap {
   YamlMap map(const std::string& key, bool required = false);
 
   void number(const std::string& key, double& out, bool required = false, double min = -1e300, double max = 1e300);
+  /// An integer in [min, max]; a fraction or a value outside the range (however large) is reported, never cast.
   void integer(const std::string& key, int& out, bool required = false, int min = -2147483647, int max = 2147483647);
+  /// A list of integers, each in [min, max] (each bad item reported with its line); false if any was reported.
+  bool integers(const std::string& key, std::vector<int>& out, int min, int max, bool required = false);
   void boolean(const std::string& key, bool& out, bool required = false);
   void text(const std::string& key, std::string& out, bool required = false);
   /// A string that must be one of `allowed`.
@@ -73,6 +82,8 @@ class YamlMap {
 
  private:
   YAML::Node get(const std::string& key, bool required);
+  /// n as an integer in [min, max] into out; false (problem reported under key) if it is not one.
+  bool integer_of(const YAML::Node& n, const std::string& key, int min, int max, int& out);
   std::string key_path(const std::string& key) const;
 
   YAML::Node node_;

@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cctype>
+#include <charconv>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -41,6 +42,18 @@ std::string csv_cell(std::string s) {
   std::string q = "\"";
   for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
   return q + "\"";
+}
+
+// keep_sats of a manifest (CSV cell or YAML scalar): an integer >= 0; any other text, a fraction or a value beyond int
+// is an error (std::from_chars reports overflow, where std::atoi's result is undefined).
+bool parse_keep_sats(std::string s, int& out) {
+  s.erase(0, s.find_first_not_of(" \t"));
+  s.erase(s.find_last_not_of(" \t\r") + 1);
+  int v = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (s.empty() || ec != std::errc() || end != s.data() + s.size() || v < 0) return false;
+  out = v;
+  return true;
 }
 
 // The accuracy figures of an item's evaluation.json (empty when it has none).
@@ -115,7 +128,9 @@ Expected<std::vector<BatchItem>> read_batch_manifest(const std::string& path) {
         else if (head[i] == "command") b.command = cells[i];
         else if (head[i] == "config") b.config = cells[i];
         else if (head[i] == "mode") b.mode = cells[i];
-        else if (head[i] == "keep_sats") b.keep_sats = std::atoi(cells[i].c_str());
+        else if (head[i] == "keep_sats" && !parse_keep_sats(cells[i], b.keep_sats))
+          problems.push_back(path + ":" + std::to_string(n) + ": keep_sats: expected an integer >= 0, got '" +
+                             cells[i] + "'");
       }
       finish(std::move(b), path + ":" + std::to_string(n));
     }
@@ -137,13 +152,23 @@ Expected<std::vector<BatchItem>> read_batch_manifest(const std::string& path) {
       }
       BatchItem b;
       for (const auto& kv : n) {
-        const std::string key = kv.first.as<std::string>();
-        if (key == "name") b.name = kv.second.as<std::string>();
-        else if (key == "command") b.command = kv.second.as<std::string>();
-        else if (key == "config") b.config = kv.second.as<std::string>();
-        else if (key == "mode") b.mode = kv.second.as<std::string>();
-        else if (key == "keep_sats") b.keep_sats = kv.second.as<int>();
-        else problems.push_back(where + ": unknown key '" + key + "'");
+        const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string();
+        const std::string value = kv.second.IsScalar() ? kv.second.Scalar() : std::string();
+        const bool known = key == "name" || key == "command" || key == "config" || key == "mode" || key == "keep_sats";
+        if (!known) {
+          problems.push_back(where + ": unknown key '" + key + "'");
+          continue;
+        }
+        if (!kv.second.IsScalar()) {
+          problems.push_back(where + ": " + key + ": expected a " + (key == "keep_sats" ? "number" : "string"));
+          continue;
+        }
+        if (key == "name") b.name = value;
+        else if (key == "command") b.command = value;
+        else if (key == "config") b.config = value;
+        else if (key == "mode") b.mode = value;
+        else if (!parse_keep_sats(value, b.keep_sats))
+          problems.push_back(where + ": keep_sats: expected an integer >= 0, got '" + value + "'");
       }
       finish(std::move(b), where);
     }

@@ -221,10 +221,27 @@ fusion::EngineInputs RunInputs::engine_inputs() const {
   return in;
 }
 
+std::vector<std::string> run_config_problems(const RunConfig& c) {
+  std::vector<std::string> p;
+  if (c.mode != "gnss") {
+    if (!c.imu.has_format) p.push_back("imu.format: required for pednav run (a preset name or a column map)");
+    if (!c.imu.has_spec) p.push_back("imu.spec: required for pednav run (a preset name or the noise values)");
+    for (const auto& f : c.imu.format.problems()) p.push_back("imu.format." + f);
+    if (c.imu.has_format && c.initial.heading_from_magnetometer && c.imu.format.mag_columns[0] < 0) {
+      p.push_back(
+          "initial.heading: magnetometer needs the magnetometer columns of imu.format (mag: {columns: [i, j, k], "
+          "unit: ut | gauss | nt | mgauss})");
+    }
+  }
+  for (const auto& e : engine_options(c).problems()) p.push_back(e);
+  return p;
+}
+
 Expected<RunInputs> load_run_inputs(const RunConfig& c) {
-  if (!c.imu.has_format) return make_error(c.source_file + ": imu.format: required for pednav run (a preset name or a column map)");
-  if (!c.imu.has_spec) {
-    return make_error(c.source_file + ": imu.spec: required for pednav run (a preset name or the noise values)");
+  if (const auto problems = run_config_problems(c); !problems.empty()) {
+    std::string all;
+    for (const auto& m : problems) all += (all.empty() ? "" : "; ") + m;
+    return make_error(c.source_file + ": " + all);
   }
   if (const auto missing = missing_input_files(c); !missing.empty()) {
     std::string all;
@@ -236,10 +253,6 @@ Expected<RunInputs> load_run_inputs(const RunConfig& c) {
   if (!imu) return imu.error();
   for (const auto& w : imu->report.warnings) spdlog::warn("{}: {}", c.imu.file, w);
   d.imu = std::move(*imu);
-  if (c.initial.heading_from_magnetometer && d.imu.mag_b.empty()) {
-    return make_error(c.source_file + ": initial.heading: magnetometer needs the magnetometer columns of imu.format "
-                                      "(mag: {columns: [i, j, k], unit: ut | gauss | nt | mgauss})");
-  }
   d.config = c;
   d.self_calibration = resolve_self_calibration(d.config, d.imu);
   if (d.self_calibration) {

@@ -6,19 +6,27 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/expected.hpp"
 #include "fusion/engine.hpp"
 #include "gnss/types.hpp"
 #include "io/config.hpp"
-#include "pipeline/self_calibration.hpp"
 #include "io/imu_csv.hpp"
 #include "io/solution_writer.hpp"
+#include "pipeline/self_calibration.hpp"
 
 namespace pednav::pipeline {
 
 /// Map the validated configuration onto the engine options (IMU spec, ZUPT, GNSS weights, antenna, clock).
 fusion::EngineOptions engine_options(const io::RunConfig& config);
+
+/// What `pednav run` rejects in a configuration before it reads any data, one line per problem naming the key
+/// ("imu.format: required ...", "fault_rejection.probability must be in (0.5, 1)"); empty when it would start.
+/// Checks the IMU format and spec a tc/ins run needs, the format's own problems, the engine options built from every
+/// key (fusion::EngineOptions::problems) and initial.heading against the format's magnetometer columns.
+/// `pednav config-check` reports the same list, so the two accept the same configurations.
+std::vector<std::string> run_config_problems(const io::RunConfig& config);
 
 /// The inputs of a run, read once: the IMU log and, in tc mode, rover/base observations and navigation data, with
 /// the engine options (base position from the configuration, else the RINEX header with a warning).

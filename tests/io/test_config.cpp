@@ -4,6 +4,7 @@
 
 #include "core/geodesy.hpp"
 #include "io/config.hpp"
+#include "io/yaml_schema.hpp"
 #include "pipeline/run_command.hpp"
 
 namespace pednav::io {
@@ -452,6 +453,97 @@ TEST(Config, InitialSectionRoundTrips) {
   ASSERT_TRUE(yaw_again->initial.yaw_rad.has_value());
   EXPECT_NEAR(*yaw_again->initial.yaw_rad, *yaw->initial.yaw_rad, 1e-12);
   EXPECT_FALSE(yaw_again->initial.heading_from_magnetometer);
+}
+
+// The resolved configuration writes each number as the shortest decimal that reads back to the same double: 0.1, not
+// yaml-cpp's 0.10000000000000001 (issue 49 item 6).
+TEST(Config, ResolvedNumbersAreTheShortestThatReadBack) {
+  auto cfg = parse(
+      "mode: gnss\nrover_obs: r.obs\nnav: n.nav\nbase_position_ecef_m: [3774085.6456, -601662.5769, "
+      "5089316.397]\ngnss: {code_sigma_zenith_m: 0.1, epoch_match_tolerance_s: 0.3}\n"
+      "antenna: {lever_arm_ned_m: [0.1, -0.2, -1.3]}\nzupt: {edge_s: 0.07}\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  const std::string y = to_yaml(*cfg);
+  EXPECT_THAT(y, HasSubstr("code_sigma_zenith_m: 0.1\n")) << y;
+  EXPECT_THAT(y, HasSubstr("epoch_match_tolerance_s: 0.3\n")) << y;
+  EXPECT_THAT(y, HasSubstr("edge_s: 0.07\n")) << y;
+  EXPECT_THAT(y, HasSubstr("lever_arm_ned_m: [0.1, -0.2, -1.3]")) << y;
+  EXPECT_THAT(y, HasSubstr("base_position_ecef_m: [3774085.6456, -601662.5769, 5089316.397]")) << y;
+  EXPECT_THAT(y, ::testing::Not(::testing::ContainsRegex("[0-9]{15}"))) << "a 17-digit form is left:\n" << y;
+  // Shortest, yet exact: every value reads back bit for bit.
+  auto again = parse(y);
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_EQ(again->gnss.code_sigma_zenith_m, cfg->gnss.code_sigma_zenith_m);
+  EXPECT_EQ(again->gnss.elevation_mask_rad, cfg->gnss.elevation_mask_rad);
+  EXPECT_EQ(again->antenna.lever_arm_ned_m, cfg->antenna.lever_arm_ned_m);
+  EXPECT_EQ(*again->gnss.base_position_ecef_m, *cfg->gnss.base_position_ecef_m);
+  EXPECT_EQ(again->zupt.edge_s, cfg->zupt.edge_s);
+  EXPECT_EQ(yaml_number(0.1), "0.1");
+  EXPECT_EQ(yaml_number(1.0 / 3.0), "0.3333333333333333");
+  EXPECT_EQ(std::stod(yaml_number(1.0 / 3.0)), 1.0 / 3.0);
+  EXPECT_EQ(yaml_number(-2.5e-7), "-2.5e-07");
+  EXPECT_EQ(yaml_number(1e300 * 1e300), ".inf");
+}
+
+// An inline IMU column map is written into the resolved configuration (it was left out, so config-check did not show
+// it and config.resolved.yaml could not be rerun) and reads back to the same format.
+TEST(Config, ResolvedConfigurationEchoesTheInlineImuFormat) {
+  auto cfg = parse(
+      "mode: ins\nimu:\n  file: imu.csv\n  spec: crista\n  format:\n    delimiter: tab\n    header_lines: 2\n"
+      "    time: {base: gps_sow, column: 1, unit: ms, gps_week: 2100}\n"
+      "    gyro: {columns: [4, 5, 6], unit: deg_per_s, signs: [1, -1, -1], full_scale_deg_per_s: 2000}\n"
+      "    accel: {columns: [7, 8, 9], unit: g, full_scale_g: 16}\n    stance: {column: 10}\n"
+      "    mag: {columns: [11, 12, 13], unit: gauss}\n    mounting_rpy_deg: [0, 0, 90]\n    max_gap_s: 0.25\n"
+      "initial: {lat_deg: 45, lon_deg: 7, h_m: 300, yaw_deg: 0}\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  const std::string y = to_yaml(*cfg);
+  EXPECT_THAT(y, HasSubstr("columns: [7, 8, 9]")) << y;
+  EXPECT_THAT(y, HasSubstr("delimiter: tab")) << y;
+  auto again = parse(y);
+  ASSERT_TRUE(again) << again.error().message << "\n" << y;
+  const ImuFormat &a = cfg->imu.format, &b = again->imu.format;
+  EXPECT_EQ(b.name, "inline");
+  EXPECT_EQ(b.delimiter, '\t');
+  EXPECT_EQ(b.header_lines, 2);
+  EXPECT_EQ(b.time_base, "gps_sow");
+  EXPECT_EQ(b.time_column, 1);
+  EXPECT_EQ(b.time_scale_s, 1e-3);
+  EXPECT_EQ(b.gps_week, 2100);
+  EXPECT_EQ(b.gyro_columns, a.gyro_columns);
+  EXPECT_EQ(b.accel_columns, a.accel_columns);
+  EXPECT_EQ(b.gyro_signs, a.gyro_signs);
+  EXPECT_EQ(b.gyro_unit, "deg_per_s");
+  EXPECT_EQ(b.accel_unit, "g");
+  EXPECT_DOUBLE_EQ(b.gyro_full_scale, a.gyro_full_scale);
+  EXPECT_DOUBLE_EQ(b.accel_full_scale, a.accel_full_scale);
+  EXPECT_EQ(b.stance_column, 10);
+  EXPECT_EQ(b.mag_columns, a.mag_columns);
+  EXPECT_EQ(b.mag_scale_to_ut, 100.0);
+  EXPECT_EQ(b.R_b_s, a.R_b_s);
+  EXPECT_THAT(y, HasSubstr("mounting_rpy_deg: [0, 0, 90]")) << "the angles as given";
+  EXPECT_EQ(b.max_gap_s, 0.25);
+  EXPECT_EQ(b.gap_factor, a.gap_factor);
+  EXPECT_EQ(b.rest_tolerance_mps2, a.rest_tolerance_mps2);
+  // A preset is written as its name.
+  auto preset = parse("mode: ins\nimu: {file: imu.csv, format: pyshoe, spec: crista}\n");
+  ASSERT_TRUE(preset) << preset.error().message;
+  EXPECT_THAT(to_yaml(*preset), HasSubstr("format: pyshoe\n"));
+}
+
+// Integer keys take whole numbers inside their range; anything else is named with its key path (never cast).
+TEST(Config, IntegerKeysAreRangeChecked) {
+  auto big = parse(
+      "mode: gnss\nrover_obs: r\nnav: n\nfault_rejection: {window_epochs: 1e71}\n"
+      "multipath: {slots: 2.5}\n");
+  ASSERT_FALSE(big);
+  EXPECT_THAT(big.error().message, HasSubstr("cfg.yaml:4: fault_rejection.window_epochs: value 1e71 is out of range"));
+  EXPECT_THAT(big.error().message, HasSubstr("cfg.yaml:5: multipath.slots: expected an integer, got '2.5'"));
+  auto list = parse("mode: gnss\nrover_obs: r\nnav: n\nreference: {file: ref.nmea, nmea_qualities: 4}\n");
+  ASSERT_FALSE(list);
+  EXPECT_THAT(list.error().message, HasSubstr("reference.nmea_qualities: expected a list of integers, got '4'"));
+  auto ok = parse("mode: gnss\nrover_obs: r\nnav: n\nreference: {file: ref.nmea, nmea_qualities: [4, 5]}\n");
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_EQ(ok->reference.nmea_qualities, (std::vector<int>{4, 5}));
 }
 
 }  // namespace

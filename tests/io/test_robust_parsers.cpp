@@ -17,6 +17,7 @@
 #include "core/geodesy.hpp"
 #include "io/config.hpp"
 #include "io/imu_csv.hpp"
+#include "io/scenario_config.hpp"
 #include "io/trajectory_io.hpp"
 
 namespace pednav::io {
@@ -203,6 +204,58 @@ TEST(RobustImuFuzzFinding, TimeStampBeyondTheGpsTimeRangeIsABadRowNotAnOverflow)
   ASSERT_FALSE(far);
   EXPECT_THAT(far.error().message, HasSubstr("0 usable IMU samples"));
   EXPECT_THAT(far.error().message, HasSubstr("is out of range"));
+}
+
+// Found by fuzz/fuzz_config (UBSan: float-cast-overflow in read_columns): a column index of 1e71 is a non-negative
+// whole number, so it passed the old check and was cast to int; in the Release build config-check accepted it and
+// `pednav run` then rejected the wrapped value. Every integer read from YAML is now range-checked before the cast.
+// The input is fuzz/corpus/fuzz_config/run_columns_1e71.yaml (after its selector byte).
+TEST(RobustConfigFuzzFinding, ColumnIndexBeyondIntIsAnErrorNamingTheKey) {
+  auto cfg = parse_run_config(
+      "mode: ins\nimu:\n  file: imu.csv\n  spec: crista\n  format:\n"
+      "    accel: {columns: [1e71, 2, 3]}\n",
+      "run.yaml", ".");
+  ASSERT_FALSE(cfg);
+  EXPECT_THAT(cfg.error().message,
+              HasSubstr("run.yaml:6: imu.format.accel.columns: value 1e71 is out of range [0, 10000]"));
+  EXPECT_EQ(cfg.error().message.find('\n'), std::string::npos) << "one line: " << cfg.error().message;
+  for (const char* bad : {"-1", "1.5", "x", "4294967297"}) {
+    auto c = parse_run_config(
+        std::string("mode: ins\nimu: {file: imu.csv, spec: crista, format: {gyro: {columns: [0, ") + bad + ", 2]}}}\n",
+        "run.yaml", ".");
+    ASSERT_FALSE(c) << bad;
+    EXPECT_THAT(c.error().message, HasSubstr("imu.format.gyro.columns: ")) << bad;
+  }
+  for (const char* key : {"header_lines: 1e71", "time: {column: -3e40}", "stance: {column: 1e10}"}) {
+    auto c = parse_run_config(std::string("mode: ins\nimu: {file: imu.csv, spec: crista, format: {") + key + "}}\n",
+                              "run.yaml", ".");
+    ASSERT_FALSE(c) << key;
+    EXPECT_THAT(c.error().message, HasSubstr("is out of range")) << key;
+  }
+}
+
+// The same pattern read the GGA fix qualities of a run's reference and of a scenario's track.
+TEST(RobustConfigFuzzFinding, NmeaQualitiesBeyondIntAreErrorsNamingTheKey) {
+  auto cfg = parse_run_config(
+      "mode: ins\nimu: {file: imu.csv, format: pyshoe, spec: crista}\n"
+      "reference: {file: ref.nmea, format: nmea, nmea_qualities: [4, 1e71]}\n",
+      "run.yaml", ".");
+  ASSERT_FALSE(cfg);
+  EXPECT_THAT(cfg.error().message,
+              HasSubstr("run.yaml:3: reference.nmea_qualities: value 1e71 is out of range [1, 9]"));
+  auto fraction = parse_run_config(
+      "mode: ins\nimu: {file: imu.csv, format: pyshoe, spec: crista}\n"
+      "reference: {file: ref.nmea, format: nmea, nmea_qualities: [4.5]}\n",
+      "run.yaml", ".");
+  ASSERT_FALSE(fraction);
+  EXPECT_THAT(fraction.error().message, HasSubstr("reference.nmea_qualities: expected an integer, got '4.5'"));
+  auto sc = parse_scenario(
+      "name: t\nseed: 1\ntrack:\n  file: track.nmea\n  nmea_qualities: [1e71]\n"
+      "  gnss: {rover_obs: r.obs, nav: n.nav}\n",
+      "scenario.yaml", "/nonexistent");
+  ASSERT_FALSE(sc);
+  EXPECT_THAT(sc.error().message,
+              HasSubstr("scenario.yaml:5: track.nmea_qualities: value 1e71 is out of range [1, 9]"));
 }
 
 // Inputs found by fuzz/fuzz_trajectory (UBSan: signed overflow in the nanosecond count of a far-future date).

@@ -36,5 +36,46 @@ TEST(EarlyChecks, AMissingReferenceFailsBeforeProcessingNamingKeyAndPath) {
   EXPECT_EQ(io::missing_input_files(*cfg).size(), 2u);  // the IMU log too, all at once
 }
 
+// `pednav config-check` and `pednav run` accept the same configurations (issue 49 item 6): what the engine options
+// or the IMU format reject at run time is in run_config_problems, which config-check prints and run refuses with.
+TEST(EarlyChecks, ConfigCheckAndRunRejectTheSameValues) {
+  const std::string dir = test::temp_dir("early_checks_agree");
+  { std::ofstream(dir + "/imu.csv") << "t,gx,gy,gz,ax,ay,az\n"; }
+  const std::string base = "mode: ins\nimu:\n  file: imu.csv\n  format: pyshoe\n  spec: gx5_25\n";
+  const std::string start = "initial: {lat_deg: 45, lon_deg: 0, h_m: 0, yaw_deg: 0}\n";
+  struct Case {
+    std::string yaml;
+    const char* problem;
+  };
+  // Each passes the YAML reader and was rejected only when the run started (engine options; the IMU log's columns).
+  const Case cases[] = {
+      {start + "fault_rejection: {probability: 0.5}\n", "fault_rejection.probability must be in (0.5, 1)"},
+      {"initial: {lat_deg: 45, lon_deg: 0, h_m: 0, heading: magnetometer}\n",
+       "initial.heading: magnetometer needs the magnetometer columns of imu.format"},
+  };
+  for (const Case& c : cases) {
+    auto cfg = io::parse_run_config(base + c.yaml, dir + "/cfg.yaml", dir);
+    ASSERT_TRUE(cfg) << c.yaml << cfg.error().message;
+    const auto problems = run_config_problems(*cfg);
+    ASSERT_EQ(problems.size(), 1u) << c.yaml;
+    EXPECT_THAT(problems.front(), HasSubstr(c.problem));
+    auto r = run_run_command(*cfg, dir + "/out");
+    ASSERT_FALSE(r) << c.yaml;
+    EXPECT_THAT(r.error().message, HasSubstr(c.problem));
+    EXPECT_FALSE(std::filesystem::exists(dir + "/out"));
+  }
+  auto ok = io::parse_run_config(base + start, dir + "/cfg.yaml", dir);
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_TRUE(run_config_problems(*ok).empty());
+  // A run needs the IMU format and spec; a GNSS-only configuration does not.
+  auto no_spec = io::parse_run_config("mode: ins\nimu: {file: imu.csv, format: pyshoe}\n", dir + "/cfg.yaml", dir);
+  ASSERT_TRUE(no_spec) << no_spec.error().message;
+  ASSERT_EQ(run_config_problems(*no_spec).size(), 1u);
+  EXPECT_THAT(run_config_problems(*no_spec).front(), HasSubstr("imu.spec: required for pednav run"));
+  auto gnss = io::parse_run_config("mode: gnss\nrover_obs: r.obs\nnav: n.nav\n", dir + "/cfg.yaml", dir);
+  ASSERT_TRUE(gnss) << gnss.error().message;
+  EXPECT_TRUE(run_config_problems(*gnss).empty());
+}
+
 }  // namespace
 }  // namespace pednav::pipeline
