@@ -73,6 +73,67 @@ TEST(IncrementIntegrator, CutKeepsTheGrid) {
   EXPECT_EQ(b[1].samples + b[2].samples, a[1].samples);
 }
 
+// IncrementIntegrator::flush closes the trailing partial interval at the last sample (end of data): it starts where the
+// last complete interval ended, holds exactly the samples after it, and with the complete intervals adds up to the
+// whole log; an empty interval (nothing pushed, the last sample on a grid point, or flushed already) gives false.
+TEST(IncrementIntegrator, FlushClosesThePartialIntervalAtTheLastSample) {
+  IncrementIntegrator empty({20.0, true, true});
+  ImuIncrement inc;
+  EXPECT_FALSE(empty.flush(inc)) << "nothing pushed";
+  std::vector<ImuSample> s;
+  for (int i = 0; i < 38; ++i) {  // 200 Hz from 2.5 ms to 187.5 ms: intervals end at 50, 100, 150 ms, then 37.5 ms left
+    ImuSample x;
+    x.t = GpsTime::from_ns(2'500'000LL + i * 5'000'000LL);
+    x.omega_ib_b = Eigen::Vector3d(0.3 + 0.01 * i, -0.2, 0.1);
+    x.f_ib_b = Eigen::Vector3d(0.5, 0.0, -9.8 + 0.02 * i);
+    s.push_back(x);
+  }
+  IncrementIntegrator integ({20.0, true, true});
+  std::vector<ImuIncrement> incs;
+  for (const auto& x : s) integ.push(x, [&](const ImuIncrement& i) { incs.push_back(i); });
+  ASSERT_EQ(incs.size(), 3u);
+  ASSERT_TRUE(integ.flush(inc));
+  EXPECT_EQ(inc.t0, incs.back().t1);
+  EXPECT_EQ(inc.t0.ns(), 150'000'000);
+  EXPECT_EQ(inc.t1, s.back().t);
+  EXPECT_NEAR(inc.dt_s, 0.0375, 1e-12);
+  EXPECT_EQ(inc.samples, 8);  // sub-intervals 150-152.5 ms (from the interpolated grid point), then 7 of 5 ms
+  EXPECT_EQ(inc.omega_end_b, s.back().omega_ib_b);
+  EXPECT_EQ(inc.f_end_b, s.back().f_ib_b);
+  // Rates linear between samples: the trapezoid sums over all intervals equal the trapezoid sum over the samples.
+  Eigen::Vector3d alpha = inc.alpha_b, upsilon = inc.upsilon_b;
+  for (const auto& i : incs) {
+    alpha += i.alpha_b;
+    upsilon += i.upsilon_b;
+  }
+  Eigen::Vector3d alpha_samples = Eigen::Vector3d::Zero(), upsilon_samples = Eigen::Vector3d::Zero();
+  for (size_t k = 1; k < s.size(); ++k) {
+    const double h = static_cast<double>(s[k].t.ns() - s[k - 1].t.ns()) * 1e-9;
+    alpha_samples += 0.5 * h * (s[k - 1].omega_ib_b + s[k].omega_ib_b);
+    upsilon_samples += 0.5 * h * (s[k - 1].f_ib_b + s[k].f_ib_b);
+  }
+  EXPECT_TRUE(alpha.isApprox(alpha_samples, 1e-12));
+  EXPECT_TRUE(upsilon.isApprox(upsilon_samples, 1e-12));
+  // The same increments as a fresh integrator started at the grid point (nothing left over from earlier intervals).
+  IncrementIntegrator fresh({20.0, true, true});
+  fresh.push(IncrementIntegrator::interpolate(s[29], s[30], inc.t0), [](const ImuIncrement&) {});
+  for (size_t k = 30; k < s.size(); ++k) fresh.push(s[k], [](const ImuIncrement&) { ADD_FAILURE(); });
+  ImuIncrement ref;
+  ASSERT_TRUE(fresh.flush(ref));
+  EXPECT_EQ(ref.samples, inc.samples);
+  EXPECT_TRUE(inc.dtheta_b.isApprox(ref.dtheta_b, 1e-15));
+  EXPECT_TRUE(inc.dv_b.isApprox(ref.dv_b, 1e-15));
+  EXPECT_TRUE(inc.dp_b.isApprox(ref.dp_b, 1e-15));
+  EXPECT_FALSE(integ.flush(inc)) << "flushed already";
+  // On the grid: a log that ends exactly at an interval end leaves nothing to flush.
+  IncrementIntegrator on_grid({20.0, true, true});
+  for (size_t k = 0; k <= 29; ++k) on_grid.push(s[k], [](const ImuIncrement&) {});  // s[29] at 147.5 ms
+  ImuSample at_end = s[29];
+  at_end.t = GpsTime::from_ns(150'000'000);
+  on_grid.push(at_end, [](const ImuIncrement&) {});
+  EXPECT_FALSE(on_grid.flush(inc)) << "the last sample closed its interval";
+}
+
 // Classic coning: R_i_b(t) = Rz(Ωt) Rx(β) Rz(-Ωt); body rate ω_b = Ω (R^T e_z - e_z) (exact), so the
 // attitude is known in closed form; the uncompensated algorithm drifts about the cone axis at
 // ≈ Ω (1 - cos β) minus what the sum of plain increments captures (Savage 1998 Part 1).

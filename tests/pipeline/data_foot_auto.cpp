@@ -36,9 +36,12 @@ constexpr double kAddedMedianMax = 1.365 * 1.05;
 constexpr double kAddedWorstMax = 2.59 * 1.05;
 constexpr int kAddedBeatsOneThresholdMin = 17;
 // x-io loops with the same configuration (held out: never used to choose an auto knob), measured 0.058 m / 0.156 m
-// end-point error (the committed x-io configuration, chosen on these loops: 0.023 / 0.122 m).
+// end-point error (the committed x-io configuration, chosen on these loops: 0.023 / 0.122 m) over a path of 25.2 m /
+// 60.0 m (measured 2026-12-06). The path length is checked too (a run that lost strides would close well): ±0.5 m, as
+// data_foot_ins.cpp (a lost or extra stride moves it by about 1 m).
 constexpr double kXioShortClosureMax_m = 0.058 * 1.05;
 constexpr double kXioLongClosureMax_m = 0.156 * 1.05;
+constexpr double kXioShortDistance_m = 25.2, kXioLongDistance_m = 60.0, kXioDistanceTol_m = 0.5;
 
 struct Trial {
   std::string name, split;
@@ -155,8 +158,12 @@ TEST(DataFootAuto, PyshoeTrialsOriginalAndAdded) {
 
 TEST(DataFootAuto, XioLoopsWithTheSameConfiguration) {
   PEDNAV_REQUIRE_DATA(test::shared_data("foot_xio_ngimu_loops/short_walk.csv"));
-  for (const auto& [loop, bound] : {std::pair<std::string, double>{"short", kXioShortClosureMax_m},
-                                    {"long", kXioLongClosureMax_m}}) {
+  const struct {
+    std::string loop;
+    double bound, distance_m;
+  } loops[] = {{"short", kXioShortClosureMax_m, kXioShortDistance_m},
+               {"long", kXioLongClosureMax_m, kXioLongDistance_m}};
+  for (const auto& [loop, bound, distance_m] : loops) {
     auto base = load_run_config(test::source_path("datasets/foot/xio_" + loop + ".yaml"));
     ASSERT_TRUE(base) << base.error().message;
     auto cfg = load_run_config(test::source_path("datasets/foot/pyshoe_auto.yaml"));
@@ -177,8 +184,9 @@ TEST(DataFootAuto, XioLoopsWithTheSameConfiguration) {
     args.plots = false;
     auto ev = run_compare(args);
     ASSERT_TRUE(ev) << ev.error().message;
-    std::printf("[xio %s auto] closure %.3f m of %.1f m\n", loop.c_str(), ev->closure_m, ev->distance_m);
+    std::printf("[xio %s auto] closure %.3f m of %.2f m\n", loop.c_str(), ev->closure_m, ev->distance_m);
     EXPECT_LT(ev->closure_m, bound) << loop;
+    EXPECT_NEAR(ev->distance_m, distance_m, kXioDistanceTol_m) << loop;
   }
 }
 
@@ -194,6 +202,8 @@ TEST(DataFootAuto, ShortLabelledStancesKeepTheirZupt) {
     double max_m;
     long early_ends;
   } cases[] = {{"2017-11-27-11-25-12", 0.1291 * 1.05, 7}, {"2017-11-27-11-13-41", 0.1002 * 1.05, 32}};
+  for (const auto& c : cases)
+    PEDNAV_REQUIRE_DATA(test::shared_data(std::string("foot_pyshoe_vicon/csv/") + c.trial + ".csv"));
   for (const auto& c : cases) {
     fusion::EngineSummary sum;
     const double err = run_trial(c.trial, [](RunConfig& cfg) { cfg.zupt.detector = "labels"; }, &sum);
