@@ -159,9 +159,11 @@ TEST_F(ZuptConsistency, FormFYawVarianceIsFalselyBounded) {
 // second-order effects (stance edges where the detected ZUPT is not exact). Measured 2026-12-05 (Release): max
 // difference 0.856 m, horizontal RMS error vs truth 1.024 m (split) vs 0.804 m (whole), end error 0.987 vs 0.983 m,
 // largest horizontal σ 10.93 m, final σ_yaw 10.12° / 10.08°. Errors bounded at the measured figure + 30 % (a 4-min
-// filter run: the margin covers the -O1/-O2 sanitizer builds), σ within ±10 % (a covariance: deterministic).
+// filter run), σ within ±10 % (a covariance: deterministic). The max difference, the figure that says "equivalent",
+// at + 5 % (another libm): 0.8562 m in the Release and in the ASan + UBSan RelWithDebInfo build alike (2026-12-06;
+// it was + 30 %, 1.11 m).
 constexpr double kFrameYawSigmaRad = 10.0 * kDegToRad;  // the run configurations' default initial σ_yaw
-constexpr double kSplitTrajectoryTol_m = 0.856 * 1.3;   // max horizontal difference of the two runs
+constexpr double kSplitTrajectoryTol_m = 0.8562 * 1.05;  // max horizontal difference of the two runs
 constexpr double kSplitSigmaTolRel = 0.05;              // reported horizontal / yaw σ agree within 5 %
 constexpr double kRmsSplitMax_m = 1.024 * 1.3, kRmsWholeMax_m = 0.804 * 1.3;
 constexpr double kEndSplitMax_m = 0.987 * 1.3, kEndWholeMax_m = 0.983 * 1.3;
