@@ -18,7 +18,6 @@ using Eigen::MatrixXd;
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 
-constexpr double kBaseMaxGap_s = 60.0;  // a static base's phase follows its Doppler across recording gaps (§5)
 constexpr double kPhaseClockSigma_m = 10.0;  // common-mode σ of the phase rows (eq. 8.2)
 
 }  // namespace
@@ -27,21 +26,7 @@ CarrierUpdater::CarrierUpdater(const gnss::NavData* nav, const std::vector<gnss:
                                const EngineOptions& o)
     : nav_(nav), base_(base), o_(o), rover_screen_(o.carrier_slip) {
   slots_.resize(static_cast<size_t>(std::max(0, o.ambiguity_slots)));
-  if (!base) return;
-  gnss::DopplerSlipOptions bo = o.carrier_slip;
-  bo.max_gap_s = std::max(bo.max_gap_s, kBaseMaxGap_s);
-  gnss::PhaseSlipScreen screen(bo);
-  std::map<gnss::SatId, int> arc;
-  base_arc_.resize(base->size());
-  for (size_t j = 0; j < base->size(); ++j) {
-    const auto slips = screen.screen((*base)[j]);
-    base_arc_[j].resize((*base)[j].sats.size());
-    for (size_t i = 0; i < slips.size(); ++i) {
-      int& a = arc[(*base)[j].sats[i].sat];
-      if (slips[i]) ++a, base_arc_reason_[{(*base)[j].sats[i].sat, a}] = *slips[i];
-      base_arc_[j][i] = a;
-    }
-  }
+  if (base) base_arcs_ = gnss::screen_base_phase(*base, o.carrier_slip);
 }
 
 void CarrierUpdater::screen_rover(const gnss::ObsEpoch& rover) {
@@ -107,7 +92,7 @@ CarrierEpoch CarrierUpdater::update(ErrorStateFilter& f, const gnss::ObsEpoch& r
     auto sb = gnss::satellite_state_at_reception(*nav_, so.sat, be0.time, bo.pseudorange_m);
     if (!sr || !sb) continue;
     // The base record of the matched base epoch carries its arc (a propagated copy keeps the record order).
-    const int barc = base_ && base_index >= 0 ? base_arc_[base_index][bk] : 0;
+    const int barc = base_ && base_index >= 0 ? base_arcs_.arc[base_index][bk] : 0;
     const int rarc = rover_arc_[so.sat];
     int k = -1;
     for (size_t i = 0; i < slots_.size(); ++i) {
@@ -117,8 +102,8 @@ CarrierEpoch CarrierUpdater::update(ErrorStateFilter& f, const gnss::ObsEpoch& r
       gnss::SlipReason why = gnss::SlipReason::kLossOfLock;
       if (slots_[k].rover_arc != rarc) {
         if (auto it = rover_reason_.find(so.sat); it != rover_reason_.end()) why = it->second;
-      } else if (auto it = base_arc_reason_.find({so.sat, barc}); it != base_arc_reason_.end()) {
-        why = it->second;
+      } else if (auto b = base_arcs_.reason(so.sat, barc)) {
+        why = *b;
       }
       ++sum.carrier.slips[static_cast<int>(why)];
       slots_[k] = Slot{};

@@ -16,6 +16,7 @@
 #include "fusion/engine.hpp"
 #include "fusion/error_state_filter.hpp"
 #include "fusion/lever_arm.hpp"
+#include "gnss/base_phase.hpp"
 #include "gnss/carrier.hpp"
 #include "gnss/types.hpp"
 
@@ -53,8 +54,7 @@ class CarrierUpdater {
   gnss::PhaseSlipScreen rover_screen_;
   std::map<gnss::SatId, int> rover_arc_;
   std::map<gnss::SatId, gnss::SlipReason> rover_reason_;  // reason of the newest rover arc
-  std::vector<std::vector<int>> base_arc_;
-  std::map<std::pair<gnss::SatId, int>, gnss::SlipReason> base_arc_reason_;
+  gnss::BasePhaseArcs base_arcs_;
   // Ambiguity slots of the filter: satellite, arcs, epochs locked, last epoch [ns], held.
   struct Slot {
     bool used = false;

@@ -20,7 +20,6 @@ constexpr double kInitClockSigma_m = 100.0;   // the clocks are white: re-initia
 constexpr double kInitDriftSigma_mps = 10.0;
 constexpr double kInitPosSigma_m = 10.0;
 constexpr double kInitVelSigma_mps = 2.0;
-constexpr double kBaseMaxGap_s = 60.0;
 
 double median_of(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -51,24 +50,9 @@ struct RtkFilter::Row {
 
 RtkFilter::RtkFilter(const gnss::NavData& nav, const std::vector<gnss::ObsEpoch>& base, const Vector3d& p_eb_e,
                      const RtkOptions& o)
-    : nav_(nav), base_(base), p_eb_e_(p_eb_e), o_(o), rover_screen_(o.doppler_slip) {
-  // The base's phases are screened once, in time order (eq. 2.1); each slip starts a new arc of that satellite. A
-  // static base's phase follows its Doppler across gaps in the recording (the Galway base has 1–14 s gaps), so its
-  // gap limit is kBaseMaxGap_s; loss of lock is in its LLI.
-  gnss::DopplerSlipOptions base_slip = o.doppler_slip;
-  base_slip.max_gap_s = std::max(base_slip.max_gap_s, kBaseMaxGap_s);
-  gnss::PhaseSlipScreen screen(base_slip);
-  std::map<gnss::SatId, int> arc;
-  base_arc_.resize(base.size());
-  for (size_t j = 0; j < base.size(); ++j) {
-    const auto slips = screen.screen(base[j]);
-    base_arc_[j].resize(base[j].sats.size());
-    for (size_t i = 0; i < slips.size(); ++i) {
-      int& a = arc[base[j].sats[i].sat];
-      if (slips[i]) ++a, base_arc_reason_[{base[j].sats[i].sat, a}] = *slips[i];
-      base_arc_[j][i] = a;
-    }
-  }
+    : nav_(nav), base_(base), p_eb_e_(p_eb_e), o_(o), rover_screen_(o.doppler_slip),
+      base_arcs_(gnss::screen_base_phase(base, o.doppler_slip)) {
+  // The base's phases are screened once, in time order (eq. 2.1), in the initializer above.
 }
 
 void RtkFilter::restart_state(int i, double value, double variance) {
@@ -281,13 +265,13 @@ RtkEpoch RtkFilter::process(const gnss::ObsEpoch& rover, int base_index) {
     if (!has_phase[si]) continue;
     const int k = find_amb(s.r->sat);
     const int rarc = rover_arc_[s.r->sat];
-    const int barc = base_arc_[base_index][s.base_rec];
+    const int barc = base_arcs_.arc[base_index][s.base_rec];
     if (k >= 0 && (amb_[k].rover_arc != rarc || amb_[k].base_arc != barc)) {
       gnss::SlipReason why = gnss::SlipReason::kLossOfLock;
       if (slip_reason[i]) {
         why = *slip_reason[i];
-      } else if (auto it = base_arc_reason_.find({s.r->sat, barc}); it != base_arc_reason_.end()) {
-        why = it->second;  // the base's slip (the newest one when several base epochs were skipped)
+      } else if (auto b = base_arcs_.reason(s.r->sat, barc)) {
+        why = *b;  // the base's slip (the newest one when several base epochs were skipped)
       }
       ++sum_.slips[static_cast<int>(why)];
       remove_ambiguity(static_cast<size_t>(k));
@@ -301,7 +285,7 @@ RtkEpoch RtkFilter::process(const gnss::ObsEpoch& rover, int base_index) {
     if (k < 0) {
       k = add_ambiguity(s.r->sat, 0.0, 1.0);
       amb_[k].rover_arc = rover_arc_[s.r->sat];
-      amb_[k].base_arc = base_arc_[base_index][s.base_rec];
+      amb_[k].base_arc = base_arcs_.arc[base_index][s.base_rec];
       new_amb[si] = true;
     }
     amb_of_sat[si] = k;

@@ -15,6 +15,7 @@
 
 #include "core/time.hpp"
 #include "fusion/ambiguity.hpp"
+#include "gnss/base_phase.hpp"
 #include "gnss/carrier.hpp"
 #include "gnss/measurement.hpp"
 #include "gnss/types.hpp"
@@ -93,8 +94,7 @@ class RtkFilter {
   std::optional<GpsTime> t_first_;
   gnss::PhaseSlipScreen rover_screen_;
   std::map<gnss::SatId, int> rover_arc_;
-  std::vector<std::vector<int>> base_arc_;  // per base epoch, per satellite record: arc number
-  std::map<std::pair<gnss::SatId, int>, gnss::SlipReason> base_arc_reason_;  // why a base arc started
+  gnss::BasePhaseArcs base_arcs_;
   int consecutive_fixes_ = 0;
   RtkSummary sum_;
 

@@ -2,8 +2,11 @@
 // Carrier-phase model, slip screening and double differences: see gnss/carrier.hpp and docs/carrier.md.
 #include "gnss/carrier.hpp"
 
+#include "gnss/base_phase.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 namespace pednav::gnss {
 
@@ -101,6 +104,24 @@ Eigen::MatrixXd double_difference_operator(const std::vector<int>& members, int 
     ++row;
   }
   return D;
+}
+
+BasePhaseArcs screen_base_phase(const std::vector<ObsEpoch>& base, DopplerSlipOptions o) {
+  o.max_gap_s = std::max(o.max_gap_s, kBaseMaxGap_s);
+  PhaseSlipScreen screen(o);
+  BasePhaseArcs out;
+  std::map<SatId, int> arc;
+  out.arc.resize(base.size());
+  for (size_t j = 0; j < base.size(); ++j) {
+    const auto slips = screen.screen(base[j]);
+    out.arc[j].resize(base[j].sats.size());
+    for (size_t i = 0; i < slips.size(); ++i) {
+      int& a = arc[base[j].sats[i].sat];
+      if (slips[i]) ++a, out.started_by[{base[j].sats[i].sat, a}] = *slips[i];
+      out.arc[j][i] = a;
+    }
+  }
+  return out;
 }
 
 }  // namespace pednav::gnss

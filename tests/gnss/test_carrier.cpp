@@ -9,6 +9,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "gnss/base_phase.hpp"
 #include "gnss/carrier.hpp"
 #include "gnss/rtklib/lambda.hpp"
 #include "tests/support/numdiff.hpp"
@@ -166,6 +167,21 @@ TEST(PhaseSlipScreen, ReceiverClockStepIsNotASlip) {
   PhaseSlipScreen s;
   s.screen(epoch_at(0));
   for (const auto& r : s.screen(epoch_at(1, 299792.458 / kL1_m))) EXPECT_FALSE(r.has_value());
+}
+
+TEST(BasePhase, RecordingGapsUpTo60sKeepTheArcAndASlipStartsANewOne) {
+  // Base epochs at 0, 30 (a 30-s recording gap, beyond the rover's 10-s limit) and 31 s, with a 5-cycle slip of the
+  // first satellite at 31 s.
+  std::vector<ObsEpoch> base{epoch_at(0), epoch_at(30), epoch_at(31)};
+  base[2].sats[0].carrier_cycles += 5.0;
+  const BasePhaseArcs a = screen_base_phase(base, DopplerSlipOptions{});
+  ASSERT_EQ(a.arc.size(), 3u);
+  EXPECT_EQ(a.arc[1][0], 0);  // across the gap: same arc
+  EXPECT_EQ(a.arc[2][0], 1);  // after the slip: a new arc, started by the Doppler test
+  EXPECT_EQ(a.arc[2][1], 0);
+  ASSERT_TRUE(a.reason(base[2].sats[0].sat, 1).has_value());
+  EXPECT_EQ(*a.reason(base[2].sats[0].sat, 1), SlipReason::kDoppler);
+  EXPECT_FALSE(a.reason(base[2].sats[1].sat, 0).has_value());
 }
 
 TEST(DoubleDifference, OperatorRows) {

@@ -222,14 +222,18 @@ std::map<long, Eigen::Vector3d> spirent_truth(const std::string& d) {
   return truth;
 }
 
+// The Spirent dynamic rover against its base (Klobuchar/Saastamoinen folder) in folder d, then `gnss_section`.
+std::string spirent_yaml(const std::string& d, const std::string& gnss_section) {
+  return "mode: gnss\nrover_obs: " + d + "iono-Klob_tropo-Saast/Rover-dynamic_MO_Spirent.obs\n" + "base_obs: " + d +
+         "iono-Klob_tropo-Saast/Base-static_MO_Spirent.obs\nnav: [" + d + "RINEX_GN_Spirent.23N, " + d +
+         "RINEX_EN_Spirent.23L]\n" + "base_position_ecef_m: [4157177.06580187, 671230.476590636, 4774767.03105544]\n" +
+         gnss_section;
+}
+
 TEST(GnssCommandData, SpirentDynamicNoiseFree) {
   const std::string d = shared_data("rtklib_samples/instinct_spirent_rtk_GE/");
   PEDNAV_REQUIRE_DATA(d + "Rover-dynamic_PVA_Spirent.csv");
-  const std::string yaml = "mode: gnss\nrover_obs: " + d + "iono-Klob_tropo-Saast/Rover-dynamic_MO_Spirent.obs\n" +
-                           "base_obs: " + d + "iono-Klob_tropo-Saast/Base-static_MO_Spirent.obs\nnav: [" + d +
-                           "RINEX_GN_Spirent.23N, " + d + "RINEX_EN_Spirent.23L]\n" +
-                           "base_position_ecef_m: [4157177.06580187, 671230.476590636, 4774767.03105544]\n" +
-                           "gnss:\n  carrier: off\n  systems: [G, E]\n";
+  const std::string yaml = spirent_yaml(d, "gnss:\n  carrier: off\n  systems: [G, E]\n");
   auto sum = run(yaml, "spirent");
   ASSERT_TRUE(sum) << sum.error().message;
   EXPECT_EQ(sum->epochs_solved, 601);
@@ -437,11 +441,7 @@ constexpr double kStaticRms_m = 0.020;
 TEST(GnssRtkData, SpirentDynamicFixesEveryEpochAfterTheFirstFix) {
   const std::string d = shared_data("rtklib_samples/instinct_spirent_rtk_GE/");
   PEDNAV_REQUIRE_DATA(d + "Rover-dynamic_PVA_Spirent.csv");
-  const std::string yaml = "mode: gnss\nrover_obs: " + d + "iono-Klob_tropo-Saast/Rover-dynamic_MO_Spirent.obs\n" +
-                           "base_obs: " + d + "iono-Klob_tropo-Saast/Base-static_MO_Spirent.obs\nnav: [" + d +
-                           "RINEX_GN_Spirent.23N, " + d + "RINEX_EN_Spirent.23L]\n" +
-                           "base_position_ecef_m: [4157177.06580187, 671230.476590636, 4774767.03105544]\n" +
-                           "gnss:\n  systems: [G, E]\n  elevation_mask_deg: 15\n";
+  const std::string yaml = spirent_yaml(d, "gnss:\n  systems: [G, E]\n  elevation_mask_deg: 15\n");
   auto sum = run(yaml, "spirent_rtk");
   ASSERT_TRUE(sum) << sum.error().message;
   ASSERT_TRUE(sum->carrier);
