@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fusion/kinematic_model.hpp"
 #include "gnss/least_squares.hpp"
 
 namespace pednav::fusion {
@@ -19,19 +20,6 @@ constexpr double kInitClockSigma_m = 100.0;  // the clocks are white: restarted 
 constexpr double kInitDriftSigma_mps = 10.0;
 constexpr double kInitPosSigma_m = 10.0;
 constexpr double kInitVelSigma_mps = 2.0;
-
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
-int slot_of(const std::vector<gnss::System>& systems, gnss::System s) {
-  for (size_t i = 0; i < systems.size(); ++i) {
-    if (systems[i] == s) return static_cast<int>(i);
-  }
-  return -1;
-}
 
 struct Row {
   enum Kind { kCode, kDoppler, kTdcp } kind = kCode;
@@ -55,20 +43,7 @@ void TdcpFilter::restart_state(int i, double value, double variance) {
 
 void TdcpFilter::predict(double dt) {
   // White acceleration (docs/carrier.md eq. 4.1) on p, v; the clone is a constant between epochs (eq. 9.3).
-  const int n = static_cast<int>(x_.size());
-  x_.segment<3>(0) += x_.segment<3>(3) * dt;
-  MatrixXd Phi = MatrixXd::Identity(n, n);
-  Phi.block<3, 3>(0, 3) = Eigen::Matrix3d::Identity() * dt;
-  P_ = Phi * P_ * Phi.transpose();
-  const Geodetic llh = geodetic_from_ecef(x_.segment<3>(0));
-  const Eigen::Matrix3d Ren = R_e_n(llh.lat, llh.lon);
-  const double qh = o_.accel_sigma_horizontal_mps2 * o_.accel_sigma_horizontal_mps2;
-  const double qv = o_.accel_sigma_vertical_mps2 * o_.accel_sigma_vertical_mps2;
-  const Eigen::Matrix3d Qa = Ren * Vector3d(qh, qh, qv).asDiagonal() * Ren.transpose();
-  P_.block<3, 3>(0, 0) += Qa * dt * dt * dt / 3.0;
-  P_.block<3, 3>(0, 3) += Qa * dt * dt / 2.0;
-  P_.block<3, 3>(3, 0) += Qa * dt * dt / 2.0;
-  P_.block<3, 3>(3, 3) += Qa * dt;
+  predict_white_acceleration(x_, P_, dt, o_.accel_sigma_horizontal_mps2, o_.accel_sigma_vertical_mps2);
 }
 
 void TdcpFilter::clone_position() {
@@ -100,7 +75,7 @@ TdcpEpoch TdcpFilter::process(const gnss::ObsEpoch& rover, bool use_code) {
     so.weights = o_.weights;
     so.fault_probability = o_.fault_probability;
     gnss::ObsEpoch filtered = rover;
-    std::erase_if(filtered.sats, [&](const gnss::SatObs& s) { return slot_of(o_.systems, s.sat.system) < 0; });
+    std::erase_if(filtered.sats, [&](const gnss::SatObs& s) { return system_slot(o_.systems, s.sat.system) < 0; });
     const auto sol = gnss::solve_epoch(nav_, filtered, nullptr, Vector3d::Zero(), Vector3d::Zero(), so);
     if (!sol.ok()) return out;
     const int n = 10 + 2 * n_clk();
@@ -140,7 +115,7 @@ TdcpEpoch TdcpFilter::process(const gnss::ObsEpoch& rover, bool use_code) {
   const Geodetic llh = geodetic_from_ecef(p0);
   for (const gnss::SatObs& so : rover.sats) {
     Sat s;
-    s.slot = slot_of(o_.systems, so.sat.system);
+    s.slot = system_slot(o_.systems, so.sat.system);
     if (s.slot < 0 || !std::isfinite(so.pseudorange_m)) continue;
     if (std::isfinite(so.cn0_dbhz) && so.cn0_dbhz < o_.min_cn0_dbhz) continue;
     auto sr = gnss::satellite_state_at_reception(nav_, so.sat, rover.time, so.pseudorange_m);
@@ -225,7 +200,7 @@ TdcpEpoch TdcpFilter::process(const gnss::ObsEpoch& rover, bool use_code) {
     restart_state(clock_index(s), x_(clock_index(s)) + dc, var);
     restart_state(change_index(s), x_(change_index(s)) + dt_c, var);
     for (Row& r : rows) {
-      if (slot_of(o_.systems, r.sat.system) != s) continue;
+      if (system_slot(o_.systems, r.sat.system) != s) continue;
       if (r.kind == Row::kCode) r.residual -= dc;
       if (r.kind == Row::kTdcp) r.residual -= dt_c;
     }

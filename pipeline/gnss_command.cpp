@@ -144,6 +144,22 @@ std::vector<gnss::System> rtk_systems(const GnssConfig& g) {
   return out;
 }
 
+// A gnss.csv row from a kinematic filter's epoch (RtkEpoch, TdcpEpoch): time, position, velocity and position
+// covariance in the local level frame, satellites used and rejected.
+template <typename Epoch>
+SolutionRow filter_row(const Epoch& e) {
+  SolutionRow row;
+  row.time = e.time;
+  row.p_e = e.p_ea_e;
+  const Geodetic llh = geodetic_from_ecef(e.p_ea_e);
+  const Eigen::Matrix3d R_ne = R_e_n(llh.lat, llh.lon).transpose();
+  row.v_n = R_ne * e.v_ea_e;
+  row.cov_p_n = R_ne * e.cov_p_e * R_ne.transpose();
+  row.n_sats_used = e.n_sats;
+  row.n_sats_rejected = e.n_rejected;
+  return row;
+}
+
 }  // namespace
 
 Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::string& out_dir) {
@@ -243,12 +259,16 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
   rows.reserve(rover->epochs.size());
   // Carrier phase (docs/carrier.md §4): with a base and L1 phase in both files, unless gnss.carrier: off.
   if (g.carrier != "off") {
-    sum.carrier_note = carrier_unavailable(g, *rover, base ? &*base : nullptr);
-    if (sum.carrier_note.empty()) {
-      sum.carrier = true;
-    } else if (!base && has_carrier_phase(*rover)) {
+    if (base) {
+      sum.carrier_note = carrier_unavailable(g, *rover, &*base);
+      sum.carrier = sum.carrier_note.empty();
+    } else if (has_carrier_phase(*rover)) {
       sum.tdcp = true;  // a rover alone: its phase differenced over time (docs/carrier.md §9)
-      sum.carrier_note.clear();
+    } else {
+      sum.carrier_note = g.rover_obs + " has no L1 carrier phase";
+    }
+    if (sum.carrier || sum.tdcp) {
+      // the phase is used
     } else if (g.carrier == "on") {
       return make_error(config.source_file + ": gnss.carrier: on, but " + sum.carrier_note);
     } else {
@@ -280,15 +300,7 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
       }
       ++sum.epochs_solved;
       ++sum.epochs_with_velocity;
-      SolutionRow row;
-      row.time = e.time;
-      row.p_e = e.p_ea_e;
-      const Geodetic llh = geodetic_from_ecef(e.p_ea_e);
-      const Eigen::Matrix3d R_ne = R_e_n(llh.lat, llh.lon).transpose();
-      row.v_n = R_ne * e.v_ea_e;
-      row.cov_p_n = R_ne * e.cov_p_e * R_ne.transpose();
-      row.n_sats_used = e.n_sats;
-      row.n_sats_rejected = e.n_rejected;
+      SolutionRow row = filter_row(e);
       row.pos_quality = fusion::pos_quality(e.status);
       row.age_s = e.base_age_s;
       row.solution_status = fusion::solution_status_name(e.status);
@@ -321,15 +333,7 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
       }
       ++sum.epochs_solved;
       ++sum.epochs_with_velocity;
-      SolutionRow row;
-      row.time = e.time;
-      row.p_e = e.p_ea_e;
-      const Geodetic llh = geodetic_from_ecef(e.p_ea_e);
-      const Eigen::Matrix3d R_ne = R_e_n(llh.lat, llh.lon).transpose();
-      row.v_n = R_ne * e.v_ea_e;
-      row.cov_p_n = R_ne * e.cov_p_e * R_ne.transpose();
-      row.n_sats_used = e.n_sats;
-      row.n_sats_rejected = e.n_rejected;
+      SolutionRow row = filter_row(e);
       row.pos_quality = 5;
       rows.push_back(row);
     }

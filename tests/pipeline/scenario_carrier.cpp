@@ -256,6 +256,13 @@ TEST(CarrierScenario, CodeOnlyDataStayCodeOnlyAndOnIsAnError) {
   ASSERT_FALSE(on);
   EXPECT_THAT(on.error().message, HasSubstr("gnss.carrier: on, but"));
   EXPECT_THAT(on.error().message, HasSubstr("rover.obs has no L1 carrier phase"));
+  // Without a base, `on` needs the rover's phase (time-differenced): the message names the rover file.
+  io::RunConfig nb = config("square_75m", "gnss", "on");
+  nb.gnss.base_obs.clear();
+  auto on_nb = pipeline::run_gnss_command(nb, test::temp_dir("carrier_code_on_no_base"));
+  ASSERT_FALSE(on_nb);
+  EXPECT_THAT(on_nb.error().message, HasSubstr("gnss.carrier: on, but"));
+  EXPECT_THAT(on_nb.error().message, HasSubstr("rover.obs has no L1 carrier phase"));
 }
 
 }  // namespace
