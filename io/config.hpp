@@ -82,6 +82,7 @@ struct ImuConfig {
   /// `imu.spec: auto`: the spec comes from the log's own calibration at run time (ins::spec_from_calibration,
   /// docs/ins.md §10); `spec` holds it once resolved (pipeline/self_calibration).
   bool spec_auto = false;
+  bool spec_defaulted = false;  ///< spec_auto because imu.spec was not given (the default, issue 49)
 };
 
 /// `reference:` section.
@@ -106,6 +107,7 @@ struct ZuptConfig {
   /// `shoe_threshold: auto`: γ from the log's still floor of the statistic (ins::auto_shoe_threshold), with the
   /// gait-adaptive raise next to a swing unless its keys are set (docs/zupt.md §6); resolved at run time.
   bool shoe_threshold_auto = false;
+  bool shoe_threshold_defaulted = false;  ///< auto because neither zupt.shoe_threshold nor imu.spec was given
   /// key shoe_threshold_motion: with shoe_threshold: auto, γ = the statistic at rest + this allowance
   /// (ins::AutoThresholdOptions::motion; docs/zupt.md §6)
   double shoe_threshold_motion = ins::AutoThresholdOptions{}.motion;

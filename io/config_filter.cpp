@@ -27,8 +27,12 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
     c.shoe_sigma_gyro_radps = sg * kDegToRad;
     if (z.has("shoe_threshold") && z.raw("shoe_threshold").IsScalar() && z.raw("shoe_threshold").Scalar() == "auto") {
       c.shoe_threshold_auto = true;
-    } else {
+    } else if (z.has("shoe_threshold")) {
       z.number("shoe_threshold", c.shoe_threshold, false, 1e-9, 1e12);
+    } else if (out.imu.spec_auto && out.zupt.detector == "shoe") {
+      // A self-calibrating IMU without a threshold takes the log's own (docs/zupt.md §5): the default.
+      c.shoe_threshold_auto = true;
+      c.shoe_threshold_defaulted = true;
     }
     z.number("shoe_threshold_motion", c.shoe_threshold_motion, false, 0.0, 1e6);
     if (z.has("shoe_threshold_motion") && !c.shoe_threshold_auto) {

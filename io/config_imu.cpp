@@ -210,6 +210,11 @@ void read_imu_section(YamlMap& top, ImuConfig& out) {
     } else {
       read_imu_spec_entry(imu, "spec", out.spec, out.spec_preset);
     }
+  } else if (imu.has("file")) {
+    // No spec: the log calibrates itself (pipeline/self_calibration), as with `spec: auto` (docs/configuration.md).
+    out.spec_auto = true;
+    out.spec_defaulted = true;
+    out.spec.name = "auto";
   }
 }
 

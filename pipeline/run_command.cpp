@@ -225,7 +225,6 @@ std::vector<std::string> run_config_problems(const RunConfig& c) {
   std::vector<std::string> p;
   if (c.mode != "gnss") {
     if (!c.imu.has_format) p.push_back("imu.format: required for pednav run (a preset name or a column map)");
-    if (!c.imu.has_spec) p.push_back("imu.spec: required for pednav run (a preset name or the noise values)");
     for (const auto& f : c.imu.format.problems()) p.push_back("imu.format." + f);
     if (c.imu.has_format && c.initial.heading_from_magnetometer && c.imu.format.mag_columns[0] < 0) {
       p.push_back(

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// The out-of-the-box configuration (datasets/foot/pyshoe_auto.yaml: `imu.spec: auto`, `zupt.shoe_threshold: auto`,
-// every other key default) on all 24 PyShoe Vicon trials, scored as scripts/pyshoe_cv does, and on the x-io loops.
+// The out-of-the-box configuration (datasets/foot/pyshoe_auto.yaml: the minimal one, whose `imu.spec` and
+// `zupt.shoe_threshold` default to `auto`; every other key default) on all 24 PyShoe Vicon trials, scored as
+// scripts/pyshoe_cv does, and on the x-io loops.
 // The auto knobs were chosen on the 24 trials by leave-one-session-out cross-validation (the ZARU gate and stance
 // edges of `auto` on the 4 `original` trials); the x-io loops are held out (docs/results.md "Out of the box").
 #include <gtest/gtest.h>

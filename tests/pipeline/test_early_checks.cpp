@@ -67,11 +67,29 @@ TEST(EarlyChecks, ConfigCheckAndRunRejectTheSameValues) {
   auto ok = io::parse_run_config(base + start, dir + "/cfg.yaml", dir);
   ASSERT_TRUE(ok) << ok.error().message;
   EXPECT_TRUE(run_config_problems(*ok).empty());
-  // A run needs the IMU format and spec; a GNSS-only configuration does not.
+  // A run needs the IMU format; without a spec the log calibrates itself and, with the SHOE detector and no
+  // threshold, takes its own threshold (the default); a given threshold or spec wins. A GNSS-only configuration needs
+  // neither.
   auto no_spec = io::parse_run_config("mode: ins\nimu: {file: imu.csv, format: pyshoe}\n", dir + "/cfg.yaml", dir);
   ASSERT_TRUE(no_spec) << no_spec.error().message;
-  ASSERT_EQ(run_config_problems(*no_spec).size(), 1u);
-  EXPECT_THAT(run_config_problems(*no_spec).front(), HasSubstr("imu.spec: required for pednav run"));
+  EXPECT_TRUE(run_config_problems(*no_spec).empty());
+  EXPECT_TRUE(no_spec->imu.spec_auto && no_spec->imu.spec_defaulted && !no_spec->imu.has_spec);
+  EXPECT_TRUE(no_spec->zupt.shoe_threshold_auto && no_spec->zupt.shoe_threshold_defaulted);
+  auto given = io::parse_run_config("mode: ins\nimu: {file: imu.csv, format: pyshoe}\nzupt: {shoe_threshold: 3e5}\n",
+                                    dir + "/cfg.yaml", dir);
+  ASSERT_TRUE(given) << given.error().message;
+  EXPECT_TRUE(given->imu.spec_auto);
+  EXPECT_FALSE(given->zupt.shoe_threshold_auto);
+  EXPECT_EQ(given->zupt.shoe_threshold, 3e5);
+  auto preset = io::parse_run_config("mode: ins\nimu: {file: imu.csv, format: pyshoe, spec: gx5_25}\n",
+                                     dir + "/cfg.yaml", dir);
+  ASSERT_TRUE(preset) << preset.error().message;
+  EXPECT_FALSE(preset->imu.spec_auto);
+  EXPECT_FALSE(preset->zupt.shoe_threshold_auto);
+  auto mv = io::parse_run_config("mode: ins\nimu: {file: imu.csv, format: pyshoe}\nzupt: {detector: mv}\n",
+                                 dir + "/cfg.yaml", dir);
+  ASSERT_TRUE(mv) << mv.error().message;
+  EXPECT_FALSE(mv->zupt.shoe_threshold_auto);  // the threshold is the SHOE detector's
   auto gnss = io::parse_run_config("mode: gnss\nrover_obs: r.obs\nnav: n.nav\n", dir + "/cfg.yaml", dir);
   ASSERT_TRUE(gnss) << gnss.error().message;
   EXPECT_TRUE(run_config_problems(*gnss).empty());
