@@ -387,11 +387,25 @@ Result run(const Config& config, const std::optional<ImuLog>& imu, const std::op
       raise(PyExc_FileNotFoundError, c.source_file + ": " + all);
     }
   }
+  // The IMU log is read here, outside the RTKLIB lock (the reader pipeline::load_run_inputs uses, after the same
+  // configuration check), so that only the RINEX reading of two concurrent runs is serialized.
+  const io::ImuLog* given = imu ? imu->log.get() : nullptr;
+  io::ImuLog read_log;
+  if (!given && pipeline::run_config_problems(c).empty()) {
+    Expected<io::ImuLog> l = [&] {
+      py::gil_scoped_release nogil;
+      return io::read_imu_csv(c.imu.file, c.imu.format);
+    }();
+    if (!l) raise(PyExc_ValueError, l.error().message);
+    for (const auto& w : l->report.warnings) spdlog::warn("{}: {}", c.imu.file, w);
+    read_log = std::move(*l);
+    given = &read_log;
+  }
   Expected<pipeline::RunInputs> inputs = [&] {
     py::gil_scoped_release nogil;
     std::unique_lock<std::mutex> lock(rtklib_mutex(), std::defer_lock);
     if (c.mode == "tc") lock.lock();  // RINEX through RTKLIB
-    return pipeline::load_run_inputs(c, imu ? imu->log.get() : nullptr);
+    return pipeline::load_run_inputs(c, given);
   }();
   if (!inputs) raise(PyExc_ValueError, inputs.error().message);
   const auto& samples = inputs->imu.samples;
