@@ -8,7 +8,8 @@
    engine runs).
 
 Usage: PYTHONPATH=build/python python3 bench/python_bench.py [--bin build/bin/pednav] [--repeats 5]
-Prints the medians and the ratios; nothing is asserted."""
+Prints the medians, the ratios and the process CPU time per wall second (> 1: the threads ran at once); nothing is
+asserted. The machine's other load changes every figure: run it on an otherwise idle machine."""
 import argparse
 import os
 import pathlib
@@ -36,10 +37,16 @@ for seed in (2, 3):
 config_path = sims[0]["files"]["config"]
 
 
-def timed(f):
-    t0 = time.perf_counter()
+cpu_s = {}
+
+
+def timed(f, cpu_key=None):
+    t0, c0 = time.perf_counter(), time.process_time()
     f()
-    return time.perf_counter() - t0
+    wall = time.perf_counter() - t0
+    if cpu_key:
+        cpu_s.setdefault(cpu_key, []).append((time.process_time() - c0) / wall)
+    return wall
 
 
 # 1. Module vs CLI, alternating.
@@ -74,10 +81,13 @@ def threaded():
 
 serial_s, threaded_s = [], []
 for _ in range(args.repeats):
-    serial_s.append(timed(serial))
-    threaded_s.append(timed(threaded))
+    serial_s.append(timed(serial, "serial"))
+    threaded_s.append(timed(threaded, "threads"))
 s, t = statistics.median(serial_s), statistics.median(threaded_s)
 print(f"two forest walks: serial median {s:.3f} s, two threads median {t:.3f} s, threads / serial = {t / s:.3f} "
       f"on {os.cpu_count()} cores")
 print("  serial:  ", " ".join(f"{x:.3f}" for x in serial_s))
 print("  threads: ", " ".join(f"{x:.3f}" for x in threaded_s))
+print(f"  process CPU time / wall time (cores in use): serial median {statistics.median(cpu_s['serial']):.2f}, "
+      f"threads median {statistics.median(cpu_s['threads']):.2f}")
+print(f"  load average at the end: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
