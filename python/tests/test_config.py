@@ -28,8 +28,10 @@ def test_to_dict_round_trip(forest):
 def test_from_dict_unknown_key_names_its_yaml_path(forest):
     d = pednav.Config.from_yaml(forest["files"]["config"]).to_dict()
     d["zupt"]["no_such_key"] = 1
-    with pytest.raises(ValueError, match=r"zupt\.no_such_key"):
+    with pytest.raises(ValueError) as e:
         pednav.Config.from_dict(d)
+    # The key path, without line numbers (they would be those of the YAML made from the dict).
+    assert str(e.value) == "config: zupt.no_such_key: unknown key"
 
 
 def test_value_error_is_the_config_check_message(forest):
