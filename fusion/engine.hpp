@@ -167,7 +167,16 @@ struct EngineInputs {
   /// Test hook: called at the end of every mechanization step with the step's end time (GPST), after its updates
   /// and outputs (tests/fusion/test_allocations.cpp counts heap allocations between calls).
   std::function<void(GpsTime)> on_step;
+  /// Progress and cancellation hook (the Python module's progress bar and Ctrl-C): called every kCancelCheckSamples
+  /// IMU samples of every pass with the sample's time (GPST); returning true stops the run, which then fails with
+  /// kCancelledMessage. Empty: never called (the outputs do not depend on it).
+  std::function<bool(GpsTime)> cancel;
 };
+
+/// IMU samples between two calls of EngineInputs::cancel.
+inline constexpr size_t kCancelCheckSamples = 256;
+/// The error message of a run stopped by EngineInputs::cancel.
+inline constexpr const char* kCancelledMessage = "cancelled";
 
 /// One output epoch of the forward solution.
 struct EpochOutput {

@@ -252,6 +252,9 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
     }
     while (sat_run < sat_runs.size() && sat_runs[sat_run].last < sample_index) ++sat_run;
     const ins::ImuSample& raw = *raw_ptr;
+    if (in_.cancel && (sample_index - start) % kCancelCheckSamples == 0 && in_.cancel(raw.t)) {
+      return make_error(kCancelledMessage);
+    }
     if (po.stop && raw.t > *po.stop) break;
     if (po.at_milestone && milestone_m > 0.0 && stop_walking()) break;
     if (!raw.omega_ib_b.allFinite() || !raw.f_ib_b.allFinite()) {

@@ -27,6 +27,15 @@ Expected<TrajectoryFile> read_configured_reference(const RunConfig& c) {
 Expected<nlohmann::json> evaluate_rows(const std::vector<SolutionRow>& rows, const TrajectoryFile& reference,
                                        const std::string& reference_name, const std::string& csv_path,
                                        const std::string& json_path, const std::string& what) {
+  auto ev = evaluate_rows_text(rows, reference, reference_name, csv_path, what);
+  if (!ev) return ev.error();
+  if (auto ok = write_file_atomic(json_path, ev->json_text); !ok) return ok.error();
+  return ev->figures;
+}
+
+Expected<RowsEvaluation> evaluate_rows_text(const std::vector<SolutionRow>& rows, const TrajectoryFile& reference,
+                                            const std::string& reference_name, const std::string& csv_path,
+                                            const std::string& what) {
   eval::Trajectory sol;
   for (const auto& r : rows) {
     const Eigen::Vector3d sd_enu(std::sqrt(r.cov_p_n(1, 1)), std::sqrt(r.cov_p_n(0, 0)), std::sqrt(r.cov_p_n(2, 2)));
@@ -40,12 +49,14 @@ Expected<nlohmann::json> evaluate_rows(const std::vector<SolutionRow>& rows, con
   TrajectoryFile sf;
   sf.format = "csv";
   sf.trajectory = sol;
-  if (auto ok = write_file_atomic(json_path, evaluation_json(*ev, args, sf, reference)); !ok) return ok.error();
+  RowsEvaluation out;
+  out.json_text = evaluation_json(*ev, args, sf, reference);
   spdlog::info("{} vs reference: horizontal RMS {:.2f} m, p95 {:.2f} m, max {:.2f} m, {:.1f} % < 5 m", what,
                ev->horizontal_rms_m, ev->horizontal_p95_m, ev->horizontal_max_m, ev->bins_pct[0]);
-  return nlohmann::json{{"horizontal_rms_m", ev->horizontal_rms_m}, {"horizontal_max_m", ev->horizontal_max_m},
-                        {"availability_pct", ev->availability_pct}, {"lt5_pct", ev->bins_pct[0]},
-                        {"inside_3sigma_pct", eval::consistency_statistics(ev->errors).inside_3sigma_pct}};
+  out.figures = nlohmann::json{{"horizontal_rms_m", ev->horizontal_rms_m}, {"horizontal_max_m", ev->horizontal_max_m},
+                               {"availability_pct", ev->availability_pct}, {"lt5_pct", ev->bins_pct[0]},
+                               {"inside_3sigma_pct", eval::consistency_statistics(ev->errors).inside_3sigma_pct}};
+  return out;
 }
 
 bool has_carrier_phase(const gnss::ObsData& obs) {

@@ -27,6 +27,15 @@ Expected<nlohmann::json> evaluate_rows(const std::vector<io::SolutionRow>& rows,
                                        const std::string& reference_name, const std::string& csv_path,
                                        const std::string& json_path, const std::string& what);
 
+/// evaluate_rows without writing: the evaluation JSON text and the summary figures (logs the same line).
+struct RowsEvaluation {
+  std::string json_text;
+  nlohmann::json figures;
+};
+Expected<RowsEvaluation> evaluate_rows_text(const std::vector<io::SolutionRow>& rows, const io::TrajectoryFile& reference,
+                                            const std::string& reference_name, const std::string& csv_path,
+                                            const std::string& what);
+
 /// Why the L1 carrier cannot be used with these data (empty: it can): no base, or no phase in the rover or base file.
 /// Whether any epoch of `obs` has an L1 carrier phase.
 bool has_carrier_phase(const gnss::ObsData& obs);

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -236,22 +237,33 @@ std::vector<std::string> run_config_problems(const RunConfig& c) {
   return p;
 }
 
-Expected<RunInputs> load_run_inputs(const RunConfig& c) {
+Expected<RunInputs> load_run_inputs(const RunConfig& c) { return load_run_inputs(c, nullptr); }
+
+Expected<RunInputs> load_run_inputs(const RunConfig& c, const ImuLog* given_imu) {
   if (const auto problems = run_config_problems(c); !problems.empty()) {
     std::string all;
     for (const auto& m : problems) all += (all.empty() ? "" : "; ") + m;
     return make_error(c.source_file + ": " + all);
   }
-  if (const auto missing = missing_input_files(c); !missing.empty()) {
+  if (auto missing = missing_input_files(c); !missing.empty()) {
+    if (given_imu) {  // the log is given: imu.file is not read
+      missing.erase(std::remove_if(missing.begin(), missing.end(),
+                                   [](const std::string& m) { return m.rfind("imu.file", 0) == 0; }),
+                    missing.end());
+    }
     std::string all;
     for (const auto& m : missing) all += (all.empty() ? "" : "; ") + m;
-    return make_error(c.source_file + ": " + all);
+    if (!all.empty()) return make_error(c.source_file + ": " + all);
   }
   RunInputs d;
-  auto imu = read_imu_csv(c.imu.file, c.imu.format);
-  if (!imu) return imu.error();
-  for (const auto& w : imu->report.warnings) spdlog::warn("{}: {}", c.imu.file, w);
-  d.imu = std::move(*imu);
+  if (given_imu) {
+    d.imu = *given_imu;
+  } else {
+    auto imu = read_imu_csv(c.imu.file, c.imu.format);
+    if (!imu) return imu.error();
+    for (const auto& w : imu->report.warnings) spdlog::warn("{}: {}", c.imu.file, w);
+    d.imu = std::move(*imu);
+  }
   d.config = c;
   d.self_calibration = resolve_self_calibration(d.config, d.imu);
   if (d.self_calibration) {
@@ -304,53 +316,30 @@ Expected<RunInputs> load_run_inputs(const RunConfig& c) {
   return d;
 }
 
-Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::string& out_dir) {
+std::string run_mode_problem(const RunConfig& c) {
+  return c.mode == "gnss" ? c.source_file + ": mode gnss: use `pednav gnss` (run handles tc and ins)" : "";
+}
+
+Expected<RunOutputs> compute_run(const RunConfig& c, const RunInputs& data, std::function<bool(GpsTime)> cancel,
+                                 const std::string& out_dir) {
   const auto wall0 = std::chrono::steady_clock::now();
-  if (c.mode == "gnss") return make_error(c.source_file + ": mode gnss: use `pednav gnss` (run handles tc and ins)");
-  auto loaded = load_run_inputs(c);
-  if (!loaded) return loaded.error();
-  const RunInputs& data = *loaded;
+  if (const std::string p = run_mode_problem(c); !p.empty()) return make_error(p);
+  RunOutputs outputs;
   const ImuLog* imu = &data.imu;
   const std::optional<gnss::ObsData>& base = data.base;
   fusion::EngineOptions opt = data.options;
-  const fusion::EngineInputs in = data.engine_inputs();
+  fusion::EngineInputs in = data.engine_inputs();
+  in.cancel = std::move(cancel);
   opt.record_gnss_rows = opt.mode == fusion::Mode::kTightlyCoupled;  // residuals.csv
   auto res = fusion::run_forward(in, opt);
   if (!res) return make_error(c.source_file + ": " + res.error().message);
   fusion::EngineSummary& sum = res->summary;
   spdlog::info("initialization: {}", sum.initialization);
 
-  std::error_code ec;
-  std::filesystem::create_directories(out_dir, ec);
-  if (ec) return make_error(out_dir + ": cannot create output folder: " + ec.message());
-  const std::filesystem::path out(out_dir);
-  std::vector<SolutionRow> rows;
+  std::vector<SolutionRow>& rows = outputs.rows;
   rows.reserve(res->epochs.size());
   for (const auto& e : res->epochs) rows.push_back(solution_row(e));
-  if (auto ok = write_solution_csv((out / "solution.csv").string(), rows); !ok) return ok.error();
-  if (auto ok = write_solution_pos((out / "solution.pos").string(), rows,
-                                   {"pednav run (" + c.mode + ", forward filter, IMU position)", c.source_file});
-      !ok) {
-    return ok.error();
-  }
-  if (auto ok = write_file_atomic((out / "config.resolved.yaml").string(), to_yaml(data.config)); !ok) return ok.error();
-  // Map formats (output.formats: geojson, kml): the forward solution here, the smoothed one below.
-  auto write_maps = [&](const std::vector<SolutionRow>& r, const std::string& stem, const std::string& what) -> Expected<void> {
-    const auto& f = c.output.formats;
-    const std::string title = "pednav run " + c.mode + " (" + what + "): " + c.source_file;
-    if (std::find(f.begin(), f.end(), "geojson") != f.end()) {
-      if (auto ok = write_solution_geojson((out / (stem + ".geojson")).string(), r, title); !ok) return ok.error();
-    }
-    if (std::find(f.begin(), f.end(), "kml") != f.end()) {
-      if (auto ok = write_solution_kml((out / (stem + ".kml")).string(), r, title); !ok) return ok.error();
-    }
-    return {};
-  };
-  if (auto ok = write_maps(rows, "solution", "forward"); !ok) return ok.error();
-  if (opt.record_gnss_rows) {
-    if (auto ok = write_residuals_csv((out / "residuals.csv").string(), res->gnss_rows); !ok) return ok.error();
-  }
-  std::vector<SolutionRow> smoothed_rows;
+  std::vector<SolutionRow>& smoothed_rows = outputs.smoothed_rows;
   smoothed_rows.reserve(res->smoothed.size());
   for (const auto& e : res->smoothed) smoothed_rows.push_back(solution_row(e));
   if (!sum.smoother_message.empty()) spdlog::warn("{} (only the forward solution is written)", sum.smoother_message);
@@ -360,17 +349,9 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
                  c.imu.file, sum.saturated_runs, sum.saturated_samples, sum.saturated_runs_reconstructed,
                  sum.saturation_max_added_deg);
   }
-  if (sum.smoothed) {
-    if (auto ok = write_solution_csv((out / "smoothed.csv").string(), smoothed_rows); !ok) return ok.error();
-    if (auto ok = write_maps(smoothed_rows, "smoothed", "RTS smoothed"); !ok) return ok.error();
-    if (auto ok = write_solution_pos((out / "solution_smoothed.pos").string(), smoothed_rows,
-                                     {"pednav run (" + c.mode + ", RTS smoothed, IMU position)", c.source_file});
-        !ok) {
-      return ok.error();
-    }
-  }
+  if (!sum.smoothed) smoothed_rows.clear();
 
-  nlohmann::ordered_json j;
+  nlohmann::ordered_json& j = outputs.summary;
   j["mode"] = c.mode;
   j["initialization"] = sum.initialization;
   j["initial_yaw_deg"] = sum.initial_yaw_deg;
@@ -472,25 +453,93 @@ Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::s
   if (!c.reference.file.empty()) {
     auto ref = read_configured_reference(c);
     if (!ref) return ref.error();
-    // Forward solution -> evaluation.json (unchanged); smoothed -> evaluation_smoothed.json.
-    auto evaluate = [&](const std::vector<SolutionRow>& rs, const std::string& csv, const std::string& json_name,
-                        const std::string& key, const std::string& what) -> Expected<void> {
-      auto figures = evaluate_rows(rs, *ref, c.reference.file, (out / csv).string(), (out / json_name).string(), what);
-      if (!figures) return figures.error();
-      j[key] = *figures;
+    // Forward solution -> evaluation.json (unchanged); smoothed -> evaluation_smoothed.json. The file names in the
+    // JSON are those run_run_command writes (relative to the output folder when computed in memory).
+    auto evaluate = [&](const std::vector<SolutionRow>& rs, const std::string& csv, const std::string& key,
+                        const std::string& what, std::string& json_text) -> Expected<void> {
+      auto ev = evaluate_rows_text(rs, *ref, c.reference.file, (std::filesystem::path(out_dir) / csv).string(), what);
+      if (!ev) return ev.error();
+      j[key] = ev->figures;
+      json_text = std::move(ev->json_text);
       return {};
     };
-    if (auto ok = evaluate(rows, "solution.csv", "evaluation.json", "evaluation", "forward"); !ok) return ok.error();
+    if (auto ok = evaluate(rows, "solution.csv", "evaluation", "forward", outputs.evaluation_json); !ok) {
+      return ok.error();
+    }
     if (sum.smoothed) {
-      if (auto ok = evaluate(smoothed_rows, "smoothed.csv", "evaluation_smoothed.json", "evaluation_smoothed",
-                             "smoothed");
+      if (auto ok = evaluate(smoothed_rows, "smoothed.csv", "evaluation_smoothed", "smoothed",
+                             outputs.evaluation_smoothed_json);
           !ok) {
         return ok.error();
       }
     }
   }
-  if (auto ok = write_file_atomic((out / "summary.json").string(), j.dump(2) + "\n"); !ok) return ok.error();
-  return sum;
+  outputs.config = data.config;
+  outputs.tightly_coupled = opt.mode == fusion::Mode::kTightlyCoupled;
+  outputs.result = std::move(*res);
+  return outputs;
+}
+
+Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::string& out_dir) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  if (const std::string p = run_mode_problem(c); !p.empty()) return make_error(p);
+  auto loaded = load_run_inputs(c);
+  if (!loaded) return loaded.error();
+  auto computed = compute_run(c, *loaded, {}, out_dir);
+  if (!computed) return computed.error();
+  if (auto ok = write_run_outputs(c, *computed, out_dir, wall0); !ok) return ok.error();
+  return computed->result.summary;
+}
+
+Expected<void> write_run_outputs(const RunConfig& c, RunOutputs& o, const std::string& out_dir,
+                                 std::optional<std::chrono::steady_clock::time_point> wall0) {
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) return make_error(out_dir + ": cannot create output folder: " + ec.message());
+  const std::filesystem::path out(out_dir);
+  const fusion::EngineSummary& sum = o.result.summary;
+  if (auto ok = write_solution_csv((out / "solution.csv").string(), o.rows); !ok) return ok.error();
+  if (auto ok = write_solution_pos((out / "solution.pos").string(), o.rows,
+                                   {"pednav run (" + c.mode + ", forward filter, IMU position)", c.source_file});
+      !ok) {
+    return ok.error();
+  }
+  if (auto ok = write_file_atomic((out / "config.resolved.yaml").string(), to_yaml(o.config)); !ok) return ok.error();
+  // Map formats (output.formats: geojson, kml): the forward solution here, the smoothed one below.
+  auto write_maps = [&](const std::vector<SolutionRow>& r, const std::string& stem, const std::string& what) -> Expected<void> {
+    const auto& f = c.output.formats;
+    const std::string title = "pednav run " + c.mode + " (" + what + "): " + c.source_file;
+    if (std::find(f.begin(), f.end(), "geojson") != f.end()) {
+      if (auto ok = write_solution_geojson((out / (stem + ".geojson")).string(), r, title); !ok) return ok.error();
+    }
+    if (std::find(f.begin(), f.end(), "kml") != f.end()) {
+      if (auto ok = write_solution_kml((out / (stem + ".kml")).string(), r, title); !ok) return ok.error();
+    }
+    return {};
+  };
+  if (auto ok = write_maps(o.rows, "solution", "forward"); !ok) return ok.error();
+  if (o.tightly_coupled) {
+    if (auto ok = write_residuals_csv((out / "residuals.csv").string(), o.result.gnss_rows); !ok) return ok.error();
+  }
+  if (sum.smoothed) {
+    if (auto ok = write_solution_csv((out / "smoothed.csv").string(), o.smoothed_rows); !ok) return ok.error();
+    if (auto ok = write_maps(o.smoothed_rows, "smoothed", "RTS smoothed"); !ok) return ok.error();
+    if (auto ok = write_solution_pos((out / "solution_smoothed.pos").string(), o.smoothed_rows,
+                                     {"pednav run (" + c.mode + ", RTS smoothed, IMU position)", c.source_file});
+        !ok) {
+      return ok.error();
+    }
+  }
+  if (!o.evaluation_json.empty()) {
+    if (auto ok = write_file_atomic((out / "evaluation.json").string(), o.evaluation_json); !ok) return ok.error();
+  }
+  if (!o.evaluation_smoothed_json.empty()) {
+    if (auto ok = write_file_atomic((out / "evaluation_smoothed.json").string(), o.evaluation_smoothed_json); !ok) {
+      return ok.error();
+    }
+  }
+  if (wall0) o.summary["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - *wall0).count();
+  return write_file_atomic((out / "summary.json").string(), o.summary.dump(2) + "\n");
 }
 
 }  // namespace pednav::pipeline

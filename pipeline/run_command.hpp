@@ -4,6 +4,9 @@
 // smoother.enabled also the RTS smoothed smoothed.csv, solution_smoothed.pos and evaluation_smoothed.json.
 #pragma once
 
+#include <chrono>
+#include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,10 +46,39 @@ struct RunInputs {
 
 /// Read what a `pednav run` (or an outage study) of this configuration needs; errors name the file and key.
 Expected<RunInputs> load_run_inputs(const io::RunConfig& config);
+/// The same with the IMU log given instead of read from imu.file (the Python module's arrays); null: read it.
+Expected<RunInputs> load_run_inputs(const io::RunConfig& config, const io::ImuLog* imu);
 
 /// One solution.csv / smoothed.csv row of an output epoch (IMU position, NED velocity, attitude, σ; pos quality 4
 /// with satellites used, else 5).
 io::SolutionRow solution_row(const fusion::EpochOutput& e);
+
+/// The error `pednav run` gives for the configuration's mode before reading anything (mode gnss); empty: none.
+std::string run_mode_problem(const io::RunConfig& config);
+
+/// Everything `pednav run` computes before it writes a file (the Python module returns it in memory).
+struct RunOutputs {
+  fusion::EngineResult result;                 ///< forward and smoothed epochs, w-test records (tc), counts
+  std::vector<io::SolutionRow> rows;           ///< solution.csv, solution.pos
+  std::vector<io::SolutionRow> smoothed_rows;  ///< smoothed.csv (empty when the smoother did not run)
+  nlohmann::ordered_json summary;              ///< summary.json (wall_s: the computation)
+  std::string evaluation_json;                 ///< evaluation.json text (with a reference), else empty
+  std::string evaluation_smoothed_json;        ///< evaluation_smoothed.json text (with a reference and the smoother)
+  io::RunConfig config;                        ///< with its `auto` settings resolved (config.resolved.yaml)
+  bool tightly_coupled = false;                ///< mode tc (residuals.csv)
+};
+
+/// Run the engine on loaded inputs and build every output of `pednav run` in memory. `cancel` becomes
+/// fusion::EngineInputs::cancel (a stopped run fails with fusion::kCancelledMessage); `out_dir` only names the CSV
+/// files in the evaluation JSON ("" in memory: "solution.csv").
+Expected<RunOutputs> compute_run(const io::RunConfig& config, const RunInputs& data,
+                                 std::function<bool(GpsTime)> cancel = {}, const std::string& out_dir = "");
+
+/// Write what compute_run returned as `pednav run` writes it into out_dir (created): solution.csv, solution.pos,
+/// config.resolved.yaml, maps, residuals.csv (tc), the smoothed files, evaluation JSON and summary.json (wall_s
+/// re-measured from wall0 when given).
+Expected<void> write_run_outputs(const io::RunConfig& config, RunOutputs& outputs, const std::string& out_dir,
+                                 std::optional<std::chrono::steady_clock::time_point> wall0 = std::nullopt);
 
 /// Run `pednav run` for a loaded configuration and write the outputs into out_dir (created).
 Expected<fusion::EngineSummary> run_run_command(const io::RunConfig& config, const std::string& out_dir);
