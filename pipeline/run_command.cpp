@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-2-Clause
 #include "pipeline/run_command.hpp"
+#include "pipeline/run_warnings.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -446,6 +447,10 @@ Expected<RunOutputs> compute_run(const RunConfig& c, const RunInputs& data, std:
                  {"reinitializations", sum.reinitializations},
                  {"events", sum.health_events}};
   for (const auto& e : sum.health_events) spdlog::warn("{}", e);
+  // Does the log fit the model? (docs/fusion.md §15): each warning with its figure and what to try.
+  const std::vector<RunWarning> warnings = run_warnings(*res, opt.spec);
+  j["warnings"] = run_warnings_json(warnings);
+  for (const auto& w : warnings) spdlog::warn("{}: {}; {}", c.imu.file, w.message, w.hint);
   j["accounting"] = accounting_json(*imu, data, sum, opt.mode == fusion::Mode::kTightlyCoupled);
   if (opt.carrier) j["carrier"] = carrier_json(sum, res->epochs);
   j["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: BSD-2-Clause
+// The run says when the log does not fit (issue 49 item 3, docs/fusion.md §15): checks of a finished `pednav run`
+// (ins or tc) against what a foot-mounted IMU on a walker produces, each with its measured value, the limit it broke
+// and what to try. summary.json `warnings` and the report's first lines. Pure functions of the engine's result.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "fusion/engine.hpp"
+#include "ins/imu_spec.hpp"
+
+namespace pednav::pipeline {
+
+struct RunWarning {
+  std::string code;     ///< stable identifier (summary.json)
+  std::string message;  ///< one line: what was measured against what
+  double value = 0.0;   ///< the measured figure
+  double limit = 0.0;   ///< the limit it broke
+  std::string hint;     ///< what to try
+};
+
+/// Limits of the checks (docs/fusion.md §15).
+struct RunWarningLimits {
+  /// Forward/smoothed disagreement: share of output epochs whose horizontal difference is beyond the 99 % χ²(2)
+  /// quantile of its own covariance (P_forward − P_smoothed); 1 % expected for a model that fits.
+  double disagreement_max_share = 0.05;
+  int disagreement_min_epochs = 20;
+  double stance_share_min = 0.05;        ///< stance samples / samples used, when the track is longer than below
+  double stance_share_max = 0.90;
+  double moving_track_min_m = 10.0;      ///< the stance and gait checks need this much forward track [m]
+  double step_length_min_m = 0.2;        ///< median step (half the stance-to-stance stride) [m]
+  double step_length_max_m = 2.0;
+  double cadence_min_hz = 0.3;           ///< strides per second of walking (stance to stance within max_stride_s)
+  double cadence_max_hz = 2.0;
+  double max_stride_s = 3.0;             ///< longer stance-to-stance gaps are pauses, not strides
+  double gyro_bias_sigmas = 3.0;         ///< final gyro bias estimate beyond this many of the spec's bias σ
+};
+
+/// The checks on the result of one run with the filter's IMU spec (after self-calibration). An empty list: the log
+/// fits.
+std::vector<RunWarning> run_warnings(const fusion::EngineResult& result, const ins::ImuSpec& spec,
+                                     const RunWarningLimits& limits = {});
+
+/// summary.json `warnings`: a JSON array (one object per warning: code, message, value, limit, hint).
+nlohmann::ordered_json run_warnings_json(const std::vector<RunWarning>& warnings);
+
+}  // namespace pednav::pipeline

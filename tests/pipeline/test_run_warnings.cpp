@@ -1,0 +1,127 @@
+// SPDX-License-Identifier: BSD-2-Clause
+// The run's fit warnings (pipeline/run_warnings, docs/fusion.md §15) on synthetic results: a walk that fits gives
+// none; each misfit, provoked alone, gives its own warning with its figure.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/geodesy.hpp"
+#include "pipeline/run_warnings.hpp"
+
+namespace pednav::pipeline {
+namespace {
+
+using ::testing::HasSubstr;
+
+struct Walk {
+  double speed_mps = 1.2;     // along north
+  double stride_s = 1.1;      // stance to stance
+  double stance_s = 0.33;     // stance duration
+  double duration_s = 60.0;
+  double rate_hz = 20.0;
+  double sigma_m = 0.3;       // forward horizontal σ; the smoother's is half of it
+  double smoothed_offset_m = 0.0;
+};
+
+// A foot that stands still during each stance and moves between them (the stride is speed × stride_s), with its
+// forward and smoothed outputs.
+fusion::EngineResult walk(const Walk& w) {
+  fusion::EngineResult r;
+  const Eigen::Vector3d p0 = ecef_from_geodetic({51.0 * kDegToRad, -114.0 * kDegToRad, 1000.0});
+  const Eigen::Matrix3d R_en = R_e_n(51.0 * kDegToRad, -114.0 * kDegToRad);
+  const int n = static_cast<int>(w.duration_s * w.rate_hz);
+  for (int i = 0; i < n; ++i) {
+    const double t = i / w.rate_hz;
+    const double k = std::floor(t / w.stride_s), phase = t - k * w.stride_s;
+    const bool stance = phase < w.stance_s;
+    const double north = w.speed_mps * w.stride_s * (k + (stance ? 0.0 : (phase - w.stance_s) / (w.stride_s - w.stance_s)));
+    fusion::EpochOutput e;
+    e.t = GpsTime::from_week_tow(2300, 1000.0 + t);
+    e.nav.p_eb_e = p0 + R_en * Eigen::Vector3d(north, 0.0, 0.0);
+    e.cov_p_n = Eigen::Vector3d(w.sigma_m * w.sigma_m, w.sigma_m * w.sigma_m, 0.25).asDiagonal();
+    e.zupt = stance;
+    r.epochs.push_back(e);
+    fusion::EpochOutput s = e;
+    s.cov_p_n = 0.25 * e.cov_p_n;
+    // Within the σ of the difference (√(P_f − P_s) = 0.26 m per axis): 0.1 m east, alternating.
+    s.nav.p_eb_e += R_en * Eigen::Vector3d(w.smoothed_offset_m, (i % 2 ? 0.1 : -0.1), 0.0);
+    r.smoothed.push_back(s);
+    r.summary.zupt_samples += stance ? 10 : 0;  // a 200-Hz IMU
+  }
+  r.summary.imu_samples_used = 10L * n;
+  return r;
+}
+
+ins::ImuSpec spec() {
+  ins::ImuSpec s;
+  s.gyro_bias_initial = 20.0 / 3600.0 * kDegToRad;  // 20 °/h
+  return s;
+}
+
+std::vector<std::string> codes(const std::vector<RunWarning>& ws) {
+  std::vector<std::string> c;
+  for (const auto& w : ws) c.push_back(w.code);
+  return c;
+}
+
+TEST(RunWarnings, AWalkThatFitsHasNone) {
+  const auto ws = run_warnings(walk({}), spec());
+  EXPECT_TRUE(ws.empty()) << (ws.empty() ? "" : ws.front().message);
+  EXPECT_EQ(run_warnings_json(ws).dump(), "[]");
+}
+
+TEST(RunWarnings, ForwardAndSmoothedApartBeyondTheirSigmas) {
+  Walk w;
+  w.smoothed_offset_m = 1.0;  // 1 m north against a difference σ of 0.26 m: every epoch beyond χ²(2) 99 %
+  const auto ws = run_warnings(walk(w), spec());
+  ASSERT_EQ(codes(ws), std::vector<std::string>{"forward_smoothed_disagree"});
+  EXPECT_NEAR(ws[0].value, 100.0, 1e-9);
+  EXPECT_EQ(ws[0].limit, 5.0);
+  EXPECT_THAT(ws[0].message, HasSubstr("beyond their σ's at 100.0 % of 1200 epochs"));
+  EXPECT_THAT(ws[0].hint, HasSubstr("imu.spec: auto"));
+  const auto j = run_warnings_json(ws);
+  EXPECT_EQ(j[0]["code"], "forward_smoothed_disagree");
+}
+
+TEST(RunWarnings, NoStancesOnAMovingTrack) {
+  fusion::EngineResult r = walk({});
+  for (auto& e : r.epochs) e.zupt = false;
+  r.summary.zupt_samples = 0;
+  const auto ws = run_warnings(r, spec());
+  ASSERT_EQ(codes(ws), std::vector<std::string>{"stance_share"});
+  EXPECT_EQ(ws[0].value, 0.0);
+  EXPECT_THAT(ws[0].hint, HasSubstr("is the IMU on the foot?"));
+}
+
+TEST(RunWarnings, StepsTooLongForAWalk) {
+  Walk w;
+  w.speed_mps = 4.0;  // 4.4-m strides: 2.2-m steps
+  const auto ws = run_warnings(walk(w), spec());
+  ASSERT_EQ(codes(ws), std::vector<std::string>{"step_length"});
+  EXPECT_NEAR(ws[0].value, 2.2, 0.05);
+  EXPECT_EQ(ws[0].limit, 2.0);
+}
+
+TEST(RunWarnings, CadenceThatNoGaitHas) {
+  Walk w;
+  w.stride_s = 0.4;   // 2.5 strides/s
+  w.stance_s = 0.15;
+  w.speed_mps = 2.0;  // 0.8-m strides: a plausible step, an implausible cadence
+  const auto ws = run_warnings(walk(w), spec());
+  ASSERT_EQ(codes(ws), std::vector<std::string>{"cadence"});
+  EXPECT_NEAR(ws[0].value, 2.5, 0.2);
+  EXPECT_THAT(ws[0].hint, HasSubstr("declared rate"));
+}
+
+TEST(RunWarnings, GyroBiasBeyondTheSpec) {
+  fusion::EngineResult r = walk({});
+  r.summary.imu_estimate.value.b_g = Eigen::Vector3d(0.0, -100.0 / 3600.0 * kDegToRad, 0.0);  // 100 °/h vs σ 20 °/h
+  const auto ws = run_warnings(r, spec());
+  ASSERT_EQ(codes(ws), std::vector<std::string>{"gyro_bias"});
+  EXPECT_NEAR(ws[0].value, 100.0, 1e-6);
+  EXPECT_NEAR(ws[0].limit, 60.0, 1e-6);
+  r.summary.imu_estimate.value.b_g.y() = -50.0 / 3600.0 * kDegToRad;  // 2.5 σ: no warning
+  EXPECT_TRUE(run_warnings(r, spec()).empty());
+}
+
+}  // namespace
+}  // namespace pednav::pipeline
