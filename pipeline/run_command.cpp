@@ -305,9 +305,30 @@ Expected<RunInputs> load_run_inputs(const RunConfig& c) {
   return d;
 }
 
-Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::string& out_dir) {
+Expected<RunConfig> tc_config(const RunConfig& c, const std::string& command) {
+  if (c.mode == "tc") return c;
+  std::string missing;
+  for (const auto& [key, absent] : {std::pair<const char*, bool>{"imu.file", c.imu.file.empty()},
+                                    {"rover_obs", c.gnss.rover_obs.empty()}, {"nav", c.gnss.nav.empty()}}) {
+    if (absent) missing += std::string(missing.empty() ? "" : ", ") + key;
+  }
+  if (!missing.empty()) {
+    return make_error(fmt::format("{}: mode {}: {} runs the tightly coupled filter, which needs {} (missing here){}",
+                                  c.source_file, c.mode, command, missing,
+                                  c.imu.file.empty() ? "; `pednav gnss` gives the GNSS-only solution" : ""));
+  }
+  spdlog::info("{}: mode {}: {} runs the tightly coupled filter (mode tc) on its IMU log and GNSS files",
+               c.source_file, c.mode, command);
+  RunConfig t = c;
+  t.mode = "tc";
+  return t;
+}
+
+Expected<fusion::EngineSummary> run_run_command(const RunConfig& given, const std::string& out_dir) {
   const auto wall0 = std::chrono::steady_clock::now();
-  if (c.mode == "gnss") return make_error(c.source_file + ": mode gnss: use `pednav gnss` (run handles tc and ins)");
+  auto as_run = given.mode == "gnss" ? tc_config(given, "pednav run") : Expected<RunConfig>(given);
+  if (!as_run) return as_run.error();
+  const RunConfig& c = *as_run;
   auto loaded = load_run_inputs(c);
   if (!loaded) return loaded.error();
   const RunInputs& data = *loaded;

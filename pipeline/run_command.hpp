@@ -48,7 +48,14 @@ Expected<RunInputs> load_run_inputs(const io::RunConfig& config);
 /// with satellites used, else 5).
 io::SolutionRow solution_row(const fusion::EpochOutput& e);
 
-/// Run `pednav run` for a loaded configuration and write the outputs into out_dir (created).
+/// The configuration as the tightly coupled filter runs it (issue 49 item 8: every command takes any configuration
+/// that has what it needs): mode tc as it is; another mode (a file written for `pednav gnss`, or an INS/ZUPT one with
+/// GNSS files) with mode tc when it has the IMU log and the GNSS files, else an error naming the configuration, its
+/// mode and the missing keys. `command` names the caller in messages ("pednav outage").
+Expected<io::RunConfig> tc_config(const io::RunConfig& config, const std::string& command);
+
+/// Run `pednav run` for a loaded configuration and write the outputs into out_dir (created). Mode tc and ins run as
+/// they are; a mode gnss configuration runs the tc filter (tc_config) when it has the IMU log and the GNSS files.
 Expected<fusion::EngineSummary> run_run_command(const io::RunConfig& config, const std::string& out_dir);
 
 }  // namespace pednav::pipeline
