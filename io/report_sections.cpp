@@ -225,6 +225,16 @@ void outage_section(Html& h, const fs::path& d, const fs::path& run_dir) {
                        num(j, "duration_s", "{:.0f}"),
                        j.value("against", std::string("run")) == "reference" ? "reference" : "run without outage"));
     h.table({"solution", "max error [m]", "max of RMS curve [m]", "RMS at window end [m]"}, rows);
+    // Windows the reference could not score (docs/outage.md §1, step 5): named with the reason, left out above.
+    if (j.contains("window_list") && j["window_list"].is_array()) {
+      int k = 0;
+      for (const auto& w : j["window_list"]) {
+        ++k;
+        if (w.value("scored", true)) continue;
+        h.para(fmt::format("Window {} (start {} s GPS TOW) not scored: {}.", k, num(w, "start_gps_tow_s", "{:.0f}"),
+                           w.value("unscored_reason", std::string("no reason given"))));
+      }
+    }
   }
   if (auto w = read_csv_table((d / "outages.csv").string())) {
     // Column, heading, format ("" = integer). Only the columns the file has.

@@ -16,6 +16,7 @@
 
 #include "eval/outage.hpp"
 #include "io/config.hpp"
+#include "io/report.hpp"
 #include "io/scenario_config.hpp"
 #include "pipeline/outage_command.hpp"
 #include "pipeline/simulate_command.hpp"
@@ -141,6 +142,10 @@ TEST_F(OutageCoverage, AWindowTheReferenceDoesNotCoverIsReportedAndTheStudyGoesO
   EXPECT_THAT(j["window_list"][1]["unscored_reason"].get<std::string>(), HasSubstr("nearest before"));
   // The study's figures are window 1's alone.
   EXPECT_DOUBLE_EQ(r->forward.max_error_m, r->forward.per_window[0].max_m);
+  // report.html names the window and why.
+  auto report = io::run_report_command(a.out_dir);
+  ASSERT_TRUE(report.has_value()) << report.error().message;
+  EXPECT_THAT(test::read_text(report->path), HasSubstr(") not scored: the reference has no epoch from"));
 }
 
 // The study runs the tc filter on any configuration that has its inputs; one without them is refused by name.
