@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/geodesy.hpp"
+#include "fusion/kinematic_model.hpp"
 #include "gnss/least_squares.hpp"
 
 namespace pednav::fusion {
@@ -20,19 +21,6 @@ constexpr double kInitClockSigma_m = 100.0;   // the clocks are white: re-initia
 constexpr double kInitDriftSigma_mps = 10.0;
 constexpr double kInitPosSigma_m = 10.0;
 constexpr double kInitVelSigma_mps = 2.0;
-
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
-int slot_of(const std::vector<gnss::System>& systems, gnss::System s) {
-  for (size_t i = 0; i < systems.size(); ++i) {
-    if (systems[i] == s) return static_cast<int>(i);
-  }
-  return -1;
-}
 
 }  // namespace
 
@@ -99,21 +87,8 @@ void RtkFilter::reset_all_ambiguities(gnss::SlipReason why) {
 }
 
 void RtkFilter::predict(double dt) {
-  // White-acceleration model (docs/carrier.md eq. 4.1): p += v dt; Q from the acceleration PSD in the local level frame.
-  const int n = static_cast<int>(x_.size());
-  x_.segment<3>(0) += x_.segment<3>(3) * dt;
-  MatrixXd Phi = MatrixXd::Identity(n, n);
-  Phi.block<3, 3>(0, 3) = Eigen::Matrix3d::Identity() * dt;
-  P_ = Phi * P_ * Phi.transpose();
-  const Geodetic llh = geodetic_from_ecef(x_.segment<3>(0));
-  const Eigen::Matrix3d Ren = R_e_n(llh.lat, llh.lon);
-  const double qh = o_.accel_sigma_horizontal_mps2 * o_.accel_sigma_horizontal_mps2;
-  const double qv = o_.accel_sigma_vertical_mps2 * o_.accel_sigma_vertical_mps2;
-  const Eigen::Matrix3d Qa = Ren * Vector3d(qh, qh, qv).asDiagonal() * Ren.transpose();
-  P_.block<3, 3>(0, 0) += Qa * dt * dt * dt / 3.0;
-  P_.block<3, 3>(0, 3) += Qa * dt * dt / 2.0;
-  P_.block<3, 3>(3, 0) += Qa * dt * dt / 2.0;
-  P_.block<3, 3>(3, 3) += Qa * dt;
+  // White acceleration (docs/carrier.md eq. 4.1).
+  predict_white_acceleration(x_, P_, dt, o_.accel_sigma_horizontal_mps2, o_.accel_sigma_vertical_mps2);
 }
 
 RtkEpoch RtkFilter::process(const gnss::ObsEpoch& rover, int base_index) {
@@ -141,7 +116,7 @@ RtkEpoch RtkFilter::process(const gnss::ObsEpoch& rover, int base_index) {
     so.weights = o_.weights;
     so.fault_probability = o_.fault_probability;
     gnss::ObsEpoch filtered = rover;
-    std::erase_if(filtered.sats, [&](const gnss::SatObs& s) { return slot_of(o_.systems, s.sat.system) < 0; });
+    std::erase_if(filtered.sats, [&](const gnss::SatObs& s) { return system_slot(o_.systems, s.sat.system) < 0; });
     const auto sol = gnss::solve_epoch(nav_, filtered, &be, p_eb_e_, Vector3d::Zero(), so);
     if (!sol.ok()) {
       ++sum_.none;
@@ -179,7 +154,7 @@ RtkEpoch RtkFilter::process(const gnss::ObsEpoch& rover, int base_index) {
   for (size_t i = 0; i < rover.sats.size(); ++i) {
     const gnss::SatObs& so = rover.sats[i];
     Sat s;
-    s.slot = slot_of(o_.systems, so.sat.system);
+    s.slot = system_slot(o_.systems, so.sat.system);
     if (s.slot < 0 || !std::isfinite(so.pseudorange_m)) continue;
     if (std::isfinite(so.cn0_dbhz) && so.cn0_dbhz < o_.min_cn0_dbhz) continue;
     for (size_t k = 0; k < be.sats.size(); ++k) {

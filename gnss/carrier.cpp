@@ -19,6 +19,21 @@ MeasurementRow sd_carrier_phase(SatId sat, const SignalAtReceiver& rover, const 
   return sd_pseudorange(sat, rover, base, p_ea_e, p_eb_e, clock_rb_m);
 }
 
+MeasurementRow td_carrier_phase(SatId sat, const SignalAtReceiver& now, const SignalAtReceiver& prev,
+                                const Eigen::Vector3d& p_now_e, const Eigen::Vector3d& p_prev_e, double clock_change_m) {
+  // Eq. 9.1: each epoch's phase range against the undifferenced code model without atmosphere (its change over one
+  // epoch interval is left out, eq. 9.2) and with the receiver clock's change as the one clock term.
+  const MeasurementRow k = ud_pseudorange(sat, now, p_now_e, 0.0, 0.0, 0.0);
+  const MeasurementRow j = ud_pseudorange(sat, prev, p_prev_e, 0.0, 0.0, 0.0);
+  MeasurementRow out;
+  out.sat = sat;
+  out.residual = k.residual - j.residual - clock_change_m;
+  out.J_p = k.J_p;
+  out.J_v = -j.J_p;
+  out.J_clock = 1.0;
+  return out;
+}
+
 double carrier_sigma_m(const WeightModel& model, double carrier_sigma_zenith_m, double cn0_dbhz, double elevation_rad) {
   WeightModel m = model;
   m.code_sigma_zenith_m = carrier_sigma_zenith_m;

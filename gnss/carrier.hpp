@@ -33,6 +33,15 @@ bool integer_ambiguity_system(System s);
 MeasurementRow sd_carrier_phase(SatId sat, const SignalAtReceiver& rover, const SignalAtReceiver& base,
                                 const Eigen::Vector3d& p_ea_e, const Eigen::Vector3d& p_eb_e, double clock_rb_m);
 
+/// Time-differenced carrier phase of one satellite between two epochs of the same receiver and the same phase arc
+/// (docs/carrier.md eq. 9.1): λΦ_k − λΦ_j = ρ_k(p_k) − ρ_j(p_j) − c(dt_s,k − dt_s,j) + Δ(c dt_r) + ε; the ambiguity
+/// cancels, the atmosphere's change over the interval is left out (eq. 9.2). `now`/`prev` carry λΦ [m] in
+/// pseudorange_m and the satellite state at each epoch's transmit time. Residual = measured − predicted;
+/// J_p w.r.t. p_now [m, ECEF], J_v holds the Jacobian w.r.t. p_prev (the cloned antenna position), J_clock = 1 is
+/// w.r.t. the receiver clock change Δ(c dt_r) [m].
+MeasurementRow td_carrier_phase(SatId sat, const SignalAtReceiver& now, const SignalAtReceiver& prev,
+                                const Eigen::Vector3d& p_now_e, const Eigen::Vector3d& p_prev_e, double clock_change_m);
+
 /// Carrier-phase noise σ [m] of one receiver (docs/carrier.md eq. 1.3): the code weight model's C/N0 and elevation
 /// factors (docs/gnss.md eq. W1) applied to the zenith phase σ.
 double carrier_sigma_m(const WeightModel& model, double carrier_sigma_zenith_m, double cn0_dbhz, double elevation_rad);

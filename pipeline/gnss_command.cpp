@@ -114,8 +114,50 @@ std::string summary_json(const GnssRunSummary& s, const RunConfig& c) {
         r.fixes_rejected_by_validation, r.wrong_fix_detections, r.holds, slips, r.code_rows_excluded,
         r.doppler_rows_excluded);
   }
+  if (s.tdcp) {
+    const auto& t = s.tdcp_summary;
+    std::string slips = "{";
+    for (int k = 0; k < static_cast<int>(gnss::SlipReason::kCount); ++k) {
+      slips += fmt::format("{}\"{}\": {}", k ? ", " : "", gnss::slip_reason_name(static_cast<gnss::SlipReason>(k)),
+                           t.slips[k]);
+    }
+    slips += "}";
+    j += fmt::format(
+        "  \"carrier\": {{\"used\": true, \"mode\": \"tdcp\", \"epochs\": {}, \"solved\": {}, \"tdcp_epochs\": {}, "
+        "\"tdcp_rows\": {}, \"slips\": {}, \"code_rows_excluded\": {}, \"doppler_rows_excluded\": {}}},\n",
+        t.epochs, t.solved, t.tdcp_epochs, t.tdcp_rows, slips, t.code_rows_excluded, t.doppler_rows_excluded);
+  }
   j += fmt::format("  \"wall_s\": {}\n}}\n", json_number(s.wall_s));
   return j;
+}
+
+// The configured constellations, in gnss.systems' order (one clock state each).
+std::vector<gnss::System> rtk_systems(const GnssConfig& g) {
+  std::vector<gnss::System> out;
+  for (const auto& l : g.systems) {
+    if (l == "G") out.push_back(gnss::System::kGps);
+    if (l == "R") out.push_back(gnss::System::kGlonass);
+    if (l == "E") out.push_back(gnss::System::kGalileo);
+    if (l == "C") out.push_back(gnss::System::kBeidou);
+    if (l == "J") out.push_back(gnss::System::kQzss);
+  }
+  return out;
+}
+
+// A gnss.csv row from a kinematic filter's epoch (RtkEpoch, TdcpEpoch): time, position, velocity and position
+// covariance in the local level frame, satellites used and rejected.
+template <typename Epoch>
+SolutionRow filter_row(const Epoch& e) {
+  SolutionRow row;
+  row.time = e.time;
+  row.p_e = e.p_ea_e;
+  const Geodetic llh = geodetic_from_ecef(e.p_ea_e);
+  const Eigen::Matrix3d R_ne = R_e_n(llh.lat, llh.lon).transpose();
+  row.v_n = R_ne * e.v_ea_e;
+  row.cov_p_n = R_ne * e.cov_p_e * R_ne.transpose();
+  row.n_sats_used = e.n_sats;
+  row.n_sats_rejected = e.n_rejected;
+  return row;
 }
 
 }  // namespace
@@ -217,9 +259,16 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
   rows.reserve(rover->epochs.size());
   // Carrier phase (docs/carrier.md §4): with a base and L1 phase in both files, unless gnss.carrier: off.
   if (g.carrier != "off") {
-    sum.carrier_note = carrier_unavailable(g, *rover, base ? &*base : nullptr);
-    if (sum.carrier_note.empty()) {
-      sum.carrier = true;
+    if (base) {
+      sum.carrier_note = carrier_unavailable(g, *rover, &*base);
+      sum.carrier = sum.carrier_note.empty();
+    } else if (has_carrier_phase(*rover)) {
+      sum.tdcp = true;  // a rover alone: its phase differenced over time (docs/carrier.md §9)
+    } else {
+      sum.carrier_note = g.rover_obs + " has no L1 carrier phase";
+    }
+    if (sum.carrier || sum.tdcp) {
+      // the phase is used
     } else if (g.carrier == "on") {
       return make_error(config.source_file + ": gnss.carrier: on, but " + sum.carrier_note);
     } else {
@@ -228,14 +277,7 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
   }
   if (sum.carrier) {
     fusion::RtkOptions ro;
-    ro.systems.clear();
-    for (const auto& l : g.systems) {
-      if (l == "G") ro.systems.push_back(gnss::System::kGps);
-      if (l == "R") ro.systems.push_back(gnss::System::kGlonass);
-      if (l == "E") ro.systems.push_back(gnss::System::kGalileo);
-      if (l == "C") ro.systems.push_back(gnss::System::kBeidou);
-      if (l == "J") ro.systems.push_back(gnss::System::kQzss);
-    }
+    ro.systems = rtk_systems(g);
     ro.elevation_mask_rad = g.elevation_mask_rad;
     ro.min_cn0_dbhz = g.min_cn0_dbhz;
     ro.weights = opt.weights;
@@ -258,15 +300,7 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
       }
       ++sum.epochs_solved;
       ++sum.epochs_with_velocity;
-      SolutionRow row;
-      row.time = e.time;
-      row.p_e = e.p_ea_e;
-      const Geodetic llh = geodetic_from_ecef(e.p_ea_e);
-      const Eigen::Matrix3d R_ne = R_e_n(llh.lat, llh.lon).transpose();
-      row.v_n = R_ne * e.v_ea_e;
-      row.cov_p_n = R_ne * e.cov_p_e * R_ne.transpose();
-      row.n_sats_used = e.n_sats;
-      row.n_sats_rejected = e.n_rejected;
+      SolutionRow row = filter_row(e);
       row.pos_quality = fusion::pos_quality(e.status);
       row.age_s = e.base_age_s;
       row.solution_status = fusion::solution_status_name(e.status);
@@ -277,12 +311,41 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
     progress.finish();
     sum.rtk = rtk.summary();
   }
+  if (sum.tdcp) {
+    fusion::TdcpOptions to;
+    to.systems = rtk_systems(g);
+    to.elevation_mask_rad = g.elevation_mask_rad;
+    to.min_cn0_dbhz = g.min_cn0_dbhz;
+    to.weights = opt.weights;
+    to.fault_probability = opt.fault_probability;
+    to.use_doppler = g.use_doppler;
+    to.carrier_sigma_zenith_m = g.carrier_sigma_zenith_m;
+    to.accel_sigma_horizontal_mps2 = g.rtk_accel_sigma_horizontal_mps2;
+    to.accel_sigma_vertical_mps2 = g.rtk_accel_sigma_vertical_mps2;
+    fusion::TdcpFilter tdcp(*nav, to);
+    Progress progress("gnss tdcp", static_cast<int64_t>(rover->epochs.size()), progress_enabled());
+    for (size_t i = 0; i < rover->epochs.size(); ++i) {
+      progress.update(static_cast<int64_t>(i));
+      const fusion::TdcpEpoch e = tdcp.process(rover->epochs[i]);
+      if (!e.ok) {
+        ++sum.not_solved[gnss::epoch_failure_name(gnss::EpochFailure::kTooFewSatellites)];
+        continue;
+      }
+      ++sum.epochs_solved;
+      ++sum.epochs_with_velocity;
+      SolutionRow row = filter_row(e);
+      row.pos_quality = 5;
+      rows.push_back(row);
+    }
+    progress.finish();
+    sum.tdcp_summary = tdcp.summary();
+  }
   for (int r = 0; r < static_cast<int>(gnss::RejectReason::kCount); ++r) {
     sum.satellites_rejected[gnss::reject_reason_name(static_cast<gnss::RejectReason>(r))] = 0;
   }
   Eigen::Vector3d p_prev = Eigen::Vector3d::Zero();
   Progress progress("gnss", static_cast<int64_t>(rover->epochs.size()), progress_enabled());
-  for (size_t i = 0; i < rover->epochs.size() && !sum.carrier; ++i) {
+  for (size_t i = 0; i < rover->epochs.size() && !sum.carrier && !sum.tdcp; ++i) {
     progress.update(static_cast<int64_t>(i));
     const gnss::ObsEpoch& re = rover->epochs[i];
     gnss::EpochSolution sol;
@@ -336,6 +399,7 @@ Expected<GnssRunSummary> run_gnss_command(const RunConfig& config, const std::st
   if (auto ok = write_solution_csv(dir + "gnss.csv", rows); !ok) return ok.error();
   std::vector<std::string> comment{"pednav gnss " + config.source_file,
                                    std::string("mode        : ") + (sum.carrier ? "kinematic RTK (SD code, Doppler, L1 phase)"
+                                                                    : sum.tdcp ? "kinematic, undifferenced code and Doppler, time-differenced L1 phase"
                                                                     : base     ? "single-differenced code (DGPS)"
                                                                                : "undifferenced code (single)")};
   if (auto ok = write_solution_pos(dir + "gnss.pos", rows, comment); !ok) return ok.error();

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // `pednav gnss CONFIG.yaml -o OUT`: GNSS-only epoch-by-epoch least squares (SD with a base, else undifferenced)
 // -> gnss.csv, gnss.pos, summary.json (all written atomically). With a base and L1 carrier phase in both files
-// (gnss.carrier auto/on): kinematic RTK (fusion/rtk_filter, docs/carrier.md §4). With a reference: evaluation.json.
+// (gnss.carrier auto/on): kinematic RTK (fusion/rtk_filter, docs/carrier.md §4); without a base and with L1 phase in
+// the rover: the kinematic filter with time-differenced phase (fusion/tdcp_filter, §9). With a reference:
+// evaluation.json.
 #pragma once
 
 #include <map>
@@ -12,6 +14,7 @@
 #include "core/expected.hpp"
 #include "gnss/code_smoothing.hpp"
 #include "fusion/rtk_filter.hpp"
+#include "fusion/tdcp_filter.hpp"
 #include "gnss/epoch_matching.hpp"
 #include "io/config.hpp"
 
@@ -31,6 +34,8 @@ struct GnssRunSummary {
   bool carrier = false;                   ///< RTK with L1 carrier phase (docs/carrier.md §4)
   std::string carrier_note;               ///< why the carrier is not used (gnss.carrier: auto)
   fusion::RtkSummary rtk;                 ///< with carrier
+  bool tdcp = false;                      ///< no base, L1 phase in the rover: time-differenced phase (docs/carrier.md §9)
+  fusion::TdcpSummary tdcp_summary;       ///< with tdcp
   std::optional<nlohmann::json> evaluation;  ///< with a reference
 };
 

@@ -48,15 +48,17 @@ Expected<nlohmann::json> evaluate_rows(const std::vector<SolutionRow>& rows, con
                         {"inside_3sigma_pct", eval::consistency_statistics(ev->errors).inside_3sigma_pct}};
 }
 
-std::string carrier_unavailable(const GnssConfig& g, const gnss::ObsData& rover, const gnss::ObsData* base) {
-  auto has_phase = [](const gnss::ObsData& d) {
-    for (const auto& e : d.epochs) {
-      for (const auto& s : e.sats) {
-        if (std::isfinite(s.carrier_cycles)) return true;
-      }
+bool has_carrier_phase(const gnss::ObsData& obs) {
+  for (const auto& e : obs.epochs) {
+    for (const auto& s : e.sats) {
+      if (std::isfinite(s.carrier_cycles)) return true;
     }
-    return false;
-  };
+  }
+  return false;
+}
+
+std::string carrier_unavailable(const GnssConfig& g, const gnss::ObsData& rover, const gnss::ObsData* base) {
+  const auto has_phase = has_carrier_phase;
   if (!base) return "no base_obs (the carrier needs a base)";
   if (!has_phase(rover)) return g.rover_obs + " has no L1 carrier phase";
   if (!has_phase(*base)) return g.base_obs + " has no L1 carrier phase";

@@ -28,6 +28,8 @@ Expected<nlohmann::json> evaluate_rows(const std::vector<io::SolutionRow>& rows,
                                        const std::string& json_path, const std::string& what);
 
 /// Why the L1 carrier cannot be used with these data (empty: it can): no base, or no phase in the rover or base file.
+/// Whether any epoch of `obs` has an L1 carrier phase.
+bool has_carrier_phase(const gnss::ObsData& obs);
 std::string carrier_unavailable(const io::GnssConfig& g, const gnss::ObsData& rover, const gnss::ObsData* base);
 
 /// The `gnss.ambiguity` section as the engine's options.

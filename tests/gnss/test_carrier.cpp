@@ -57,6 +57,39 @@ TEST(Carrier, SdPhaseIsTheCodeModelWithPhaseRanges) {
   EXPECT_NEAR(sd_carrier_phase(kSat, rs, kBaseSig, kRover, kBase, 50.0).residual - r0, 17 * kL1_m, 1e-7);
 }
 
+TEST(Carrier, TdcpJacobianAgainstCentralDifferences) {
+  // Eq. 9.1: the TDCP row w.r.t. the current antenna position, the previous (cloned) one and the clock change.
+  const SignalAtReceiver prev = phase_signal({1.5e7 - 3.9e3, -1.2e7 + 1.1e3, 1.8e7 + 2.4e3}, 2.2e7 - 150.0);
+  const Eigen::Vector3d p_prev = kRover - Eigen::Vector3d(0.9, -0.6, 0.2);
+  const MeasurementRow r = td_carrier_phase(kSat, kRoverSig, prev, kRover, p_prev, 4.0);
+  auto f = [&](const Eigen::VectorXd& x) {
+    Eigen::VectorXd out(1);
+    out(0) = -td_carrier_phase(kSat, kRoverSig, prev, x.head<3>(), x.segment<3>(3), x(6)).residual;
+    return out;
+  };
+  Eigen::VectorXd x(7);
+  x << kRover, p_prev, 4.0;
+  const Eigen::MatrixXd J = test::numerical_jacobian(f, x, kStepPos_m);
+  EXPECT_LT((J.block<1, 3>(0, 0) - r.J_p).norm(), kTolJacobian);
+  EXPECT_LT((J.block<1, 3>(0, 3) - r.J_v).norm(), kTolJacobian);
+  EXPECT_NEAR(J(0, 6), r.J_clock, kTolJacobian);
+}
+
+TEST(Carrier, TdcpCancelsTheAmbiguityAndIsTheDifferenceOfTwoEpochs) {
+  // An integer number of cycles on both epochs' phases (the same arc) leaves the TDCP residual unchanged; the
+  // residual is the current epoch's undifferenced residual minus the previous one's minus the clock change.
+  const SignalAtReceiver prev = phase_signal({1.5e7 - 3.9e3, -1.2e7 + 1.1e3, 1.8e7 + 2.4e3}, 2.2e7 - 150.0);
+  const Eigen::Vector3d p_prev = kRover - Eigen::Vector3d(0.9, -0.6, 0.2);
+  const double r0 = td_carrier_phase(kSat, kRoverSig, prev, kRover, p_prev, 4.0).residual;
+  SignalAtReceiver a = kRoverSig, b = prev;
+  a.pseudorange_m += 123456 * kL1_m;
+  b.pseudorange_m += 123456 * kL1_m;
+  EXPECT_NEAR(td_carrier_phase(kSat, a, b, kRover, p_prev, 4.0).residual, r0, 1e-6);
+  const double k = ud_pseudorange(kSat, kRoverSig, kRover, 0.0, 0.0, 0.0).residual;
+  const double j = ud_pseudorange(kSat, prev, p_prev, 0.0, 0.0, 0.0).residual;
+  EXPECT_NEAR(r0, k - j - 4.0, 1e-9);
+}
+
 TEST(Carrier, PhaseSigmaFollowsTheWeightModel) {
   WeightModel w;  // cn0_ref 45, elevation weight 1
   EXPECT_NEAR(carrier_sigma_m(w, 0.003, 50.0, kPi / 2), 0.003, 1e-12);

@@ -14,6 +14,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/geodesy.hpp"
+#include "fusion/tdcp_filter.hpp"
+#include "gnss/rtklib/rinex.hpp"
 #include "io/config.hpp"
 #include "io/scenario_config.hpp"
 #include "pipeline/gnss_command.hpp"
@@ -98,6 +101,144 @@ TEST(CarrierScenario, GnssRtkFixesAndCountsTheSimulatedSlips) {
   EXPECT_EQ(r.wrong_fix_detections, 0);
 }
 
+// The simulated rover antenna (truth.csv ant_x/y/z at 100 Hz) and its velocity by central differences over ±0.1 s.
+struct AntennaTruth {
+  double tow0 = 0.0, step_s = 0.01;
+  std::vector<Eigen::Vector3d> p;
+  Eigen::Vector3d at(double tow) const {
+    const double f = (tow - tow0) / step_s;
+    const size_t i = static_cast<size_t>(std::clamp(f, 0.0, static_cast<double>(p.size() - 2)));
+    const double a = f - static_cast<double>(i);
+    return (1.0 - a) * p[i] + a * p[i + 1];
+  }
+  Eigen::Vector3d velocity(double tow) const { return (at(tow + 0.1) - at(tow - 0.1)) / 0.2; }
+};
+
+AntennaTruth read_antenna_truth(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  AntennaTruth t;
+  std::vector<double> tow;
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) v.push_back(std::atof(cell.c_str()));
+    if (v.size() < 17) continue;
+    tow.push_back(v[1]);
+    t.p.emplace_back(v[14], v[15], v[16]);
+  }
+  t.tow0 = tow.front();
+  t.step_s = (tow.back() - tow.front()) / static_cast<double>(tow.size() - 1);
+  return t;
+}
+
+struct TdcpRun {
+  double velocity_rms_mps = 0.0;       // horizontal, at the epoch, every solved epoch after the first 10 s
+  double mean_velocity_rms_mps = 0.0;  // horizontal, the mean over each epoch interval (displacement / Δt)
+  double drift_m = 0.0;           // horizontal error growth over the code outage (max |e(t) − e(start)|)
+  fusion::TdcpSummary sum;
+};
+
+// pednav's GNSS-only rover filter on forest_walk_carrier's rover.obs (no base), with or without the TDCP rows, the code
+// rows left out over [outage_tow, outage_tow + 60 s) when outage_tow > 0.
+TdcpRun run_tdcp(bool phase, double outage_tow) {
+  const std::string dir = sim_dir("forest_walk_carrier");
+  static const AntennaTruth truth = read_antenna_truth(dir + "/truth.csv");
+  auto obs = gnss::read_rinex_obs(dir + "/rover.obs", gnss::SystemSelection{});
+  auto nav = gnss::read_rinex_nav({dir + "/nav.rnx"});
+  EXPECT_TRUE(obs && nav);
+  if (!obs || !nav) return {};
+  fusion::TdcpOptions o;
+  o.use_phase = phase;
+  fusion::TdcpFilter f(*nav, o);
+  TdcpRun out;
+  double sq = 0.0, sq_mean = 0.0;
+  int n = 0;
+  std::optional<Eigen::Vector3d> e_start;
+  const double t0 = obs->epochs.front().time.tow_s();
+  for (const gnss::ObsEpoch& ep : obs->epochs) {
+    const double tow = ep.time.tow_s();
+    const bool outage = outage_tow > 0.0 && tow >= outage_tow && tow < outage_tow + 60.0;
+    const fusion::TdcpEpoch e = f.process(ep, !outage);
+    if (!e.ok) continue;
+    const Geodetic llh = geodetic_from_ecef(e.p_ea_e);
+    const Eigen::Matrix3d R_ne = R_e_n(llh.lat, llh.lon).transpose();
+    const Eigen::Vector3d dv = R_ne * (e.v_ea_e - truth.velocity(tow));
+    if (tow - t0 > 10.0 && e.dt_s > 0.0) {
+      sq += dv.head<2>().squaredNorm();
+      const Eigen::Vector3d dm = R_ne * (e.displacement_e - (truth.at(tow) - truth.at(tow - e.dt_s))) / e.dt_s;
+      sq_mean += dm.head<2>().squaredNorm();
+      ++n;
+    }
+    const Eigen::Vector3d err = R_ne * (e.p_ea_e - truth.at(tow));
+    if (!outage && tow < outage_tow) e_start = err;
+    if (outage && e_start) out.drift_m = std::max(out.drift_m, (err - *e_start).head<2>().norm());
+  }
+  out.velocity_rms_mps = std::sqrt(sq / std::max(n, 1));
+  out.mean_velocity_rms_mps = std::sqrt(sq_mean / std::max(n, 1));
+  out.sum = f.summary();
+  return out;
+}
+
+TEST(CarrierScenario, TdcpWithoutBaseGivesCarrierQualityDisplacement) {
+  // docs/carrier.md §9: the rover alone (no base), GNSS only. Horizontal velocity RMS, and the drift over four 60-s code
+  // outages under the canopy (Doppler and phase kept), with and without the TDCP rows.
+  const TdcpRun on = run_tdcp(true, 0.0), off = run_tdcp(false, 0.0);
+  std::printf("[forest_walk_carrier tdcp] horizontal velocity RMS over each epoch interval: code+Doppler %.4f m/s, "
+              "+ TDCP %.4f m/s (%.1fx)\n", off.mean_velocity_rms_mps, on.mean_velocity_rms_mps,
+              off.mean_velocity_rms_mps / on.mean_velocity_rms_mps);
+  std::printf("[forest_walk_carrier tdcp] horizontal velocity RMS at the epoch: code+Doppler %.4f m/s, + TDCP %.4f m/s (%.1fx); "
+              "TDCP epochs %d of %d, rows %d, slips loss_of_lock %d half_cycle %d doppler %d geometry %d gap %d\n",
+              off.velocity_rms_mps, on.velocity_rms_mps, off.velocity_rms_mps / on.velocity_rms_mps, on.sum.tdcp_epochs,
+              on.sum.epochs, on.sum.tdcp_rows, on.sum.slips[0], on.sum.slips[1], on.sum.slips[2], on.sum.slips[3],
+              on.sum.slips[4]);
+  double drift_on = 0.0, drift_off = 0.0;
+  for (const double start : {225300.0, 225500.0, 225700.0, 225900.0}) {
+    const double a = run_tdcp(true, start).drift_m, b = run_tdcp(false, start).drift_m;
+    std::printf("[forest_walk_carrier tdcp] code outage at %.0f s: drift code+Doppler %.3f m, + TDCP %.3f m\n",
+                start - 225000.0, b, a);
+    drift_on = std::max(drift_on, a);
+    drift_off = std::max(drift_off, b);
+  }
+  std::printf("[forest_walk_carrier tdcp] worst 60-s drift: code+Doppler %.3f m, + TDCP %.3f m (%.1fx)\n", drift_off,
+              drift_on, drift_off / drift_on);
+  // Figures measured 2026-12-06 (Release, deterministic); bounds: measured + 15 %, the 3x on both ratios.
+  EXPECT_EQ(off.sum.tdcp_rows, 0);
+  EXPECT_GT(on.sum.tdcp_epochs, 1000);
+  EXPECT_LT(on.mean_velocity_rms_mps, 1.15 * 0.0502);
+  EXPECT_GT(off.mean_velocity_rms_mps / on.mean_velocity_rms_mps, 3.0);
+  EXPECT_LT(on.velocity_rms_mps, 1.15 * 0.1315);
+  EXPECT_LT(drift_on, 1.15 * 0.972);
+  EXPECT_GT(drift_off / drift_on, 3.0);
+}
+
+TEST(CarrierScenario, GnssWithoutBaseRunsTheTdcpFilterAndSaysSo) {
+  // `pednav gnss` on the rover file alone: auto picks the TDCP filter (summary.json carrier.mode), off the epoch
+  // least squares; both solve every epoch.
+  io::RunConfig c = config("forest_walk_carrier", "gnss", "auto");
+  c.gnss.base_obs.clear();
+  const std::string a = test::temp_dir("carrier_tdcp_auto"), b = test::temp_dir("carrier_tdcp_off");
+  auto sa = pipeline::run_gnss_command(c, a);
+  ASSERT_TRUE(sa) << sa.error().message;
+  EXPECT_TRUE(sa->tdcp);
+  EXPECT_FALSE(sa->carrier);
+  EXPECT_EQ(sa->tdcp_summary.epochs, 1081);
+  EXPECT_GT(sa->tdcp_summary.tdcp_epochs, 1000);
+  const auto js = summary(a);
+  EXPECT_EQ(js["carrier"]["mode"], "tdcp");
+  EXPECT_EQ(js["carrier"]["tdcp_rows"].get<int>(), sa->tdcp_summary.tdcp_rows);
+  c.gnss.carrier = "off";
+  auto sb = pipeline::run_gnss_command(c, b);
+  ASSERT_TRUE(sb) << sb.error().message;
+  EXPECT_FALSE(sb->tdcp);
+  EXPECT_FALSE(summary(b).contains("carrier"));
+  std::printf("[forest_walk_carrier gnss, no base] solved: tdcp filter %d, epoch least squares %d\n", sa->epochs_solved,
+              sb->epochs_solved);
+  EXPECT_GE(sa->epochs_solved, sb->epochs_solved);
+}
+
 TEST(CarrierScenario, CodeOnlyDataStayCodeOnlyAndOnIsAnError) {
   const std::string a = test::temp_dir("carrier_code_auto"), b = test::temp_dir("carrier_code_off");
   auto sa = pipeline::run_gnss_command(config("square_75m", "gnss", "auto"), a);
@@ -115,6 +256,13 @@ TEST(CarrierScenario, CodeOnlyDataStayCodeOnlyAndOnIsAnError) {
   ASSERT_FALSE(on);
   EXPECT_THAT(on.error().message, HasSubstr("gnss.carrier: on, but"));
   EXPECT_THAT(on.error().message, HasSubstr("rover.obs has no L1 carrier phase"));
+  // Without a base, `on` needs the rover's phase (time-differenced): the message names the rover file.
+  io::RunConfig nb = config("square_75m", "gnss", "on");
+  nb.gnss.base_obs.clear();
+  auto on_nb = pipeline::run_gnss_command(nb, test::temp_dir("carrier_code_on_no_base"));
+  ASSERT_FALSE(on_nb);
+  EXPECT_THAT(on_nb.error().message, HasSubstr("gnss.carrier: on, but"));
+  EXPECT_THAT(on_nb.error().message, HasSubstr("rover.obs has no L1 carrier phase"));
 }
 
 }  // namespace
