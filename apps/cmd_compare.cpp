@@ -18,7 +18,8 @@ void add_compare_command(CLI::App& app, Action& action) {
   auto qualities = std::make_shared<std::vector<int>>();
   cmd->add_option("SOLUTION", args->solution, "Solution: pednav CSV (solution/gnss/smoothed/truth), RTKLIB .pos")
       ->required();
-  cmd->add_option("REFERENCE", args->reference, "Reference: NMEA GGA, RTKLIB .pos or CSV (see README)")->required();
+  cmd->add_option("REFERENCE", args->reference, "Reference: NMEA GGA, RTKLIB .pos or CSV (see docs/cli.md)")
+      ->required();
   cmd->add_option("-o,--out", args->out_dir, "Output folder")->required();
   cmd->add_option("--solution-format", *sol_format, "auto|csv|pos|nmea")->check(CLI::IsMember({"auto", "csv", "pos", "nmea"}));
   cmd->add_option("--reference-format", *ref_format, "auto|csv|pos|nmea")->check(CLI::IsMember({"auto", "csv", "pos", "nmea"}));

@@ -16,9 +16,13 @@ void add_outage_command(CLI::App& app, Action& action) {
   auto full = std::make_shared<bool>(false);
   auto keep = std::make_shared<int>(-1);
   auto keep_by = std::make_shared<std::string>("elevation");
-  cmd->add_option("CONFIG", *config, "Run configuration (YAML, mode tc)")->required();
+  cmd->add_option("CONFIG", *config,
+                  "Run configuration (YAML; any mode with the IMU log and GNSS files: the study runs tc)")
+      ->required();
   cmd->add_option("-o,--out", args->out_dir, "Output folder")->required();
-  cmd->add_option("--windows", args->windows, "Number of windows placed evenly after convergence (default 5)")
+  cmd->add_option("--windows", args->windows,
+                  "Number of windows after convergence, one per K-th of the span, where the reference covers it "
+                  "(default 5)")
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--duration", args->duration_s, "Window length [s] (default 100)")->check(CLI::PositiveNumber);
   cmd->add_option("--starts", args->start_tow_s, "Explicit window starts, GPS seconds of week (instead of --windows)");
@@ -40,7 +44,8 @@ void add_outage_command(CLI::App& app, Action& action) {
   cmd->add_flag("!--no-plot", args->plot, "Do not write outage_rms.svg");
   cmd->add_flag("--write-runs", args->write_runs, "Also write window_<k>/solution.csv (+ smoothed.csv) of each run");
   auto mode = std::make_shared<std::string>();
-  cmd->add_option("--mode", *mode, "Override the config's mode (the study needs tc)")->check(CLI::IsMember({"tc"}));
+  cmd->add_option("--mode", *mode, "Accepted for older scripts: the study always runs the tightly coupled filter")
+      ->check(CLI::IsMember({"tc"}));
   cmd->callback([&action, config, args, full, keep, keep_by, mode] {
     action = [config, args, full, keep, keep_by, mode] {
       if (!*full && *keep < 0) {

@@ -9,7 +9,8 @@
 namespace pednav::apps {
 
 void add_run_command(CLI::App& app, Action& action) {
-  auto* cmd = app.add_subcommand("run", "Tightly coupled foot-IMU + GNSS filter (mode tc) or INS/ZUPT (mode ins)");
+  auto* cmd = app.add_subcommand(
+      "run", "Tightly coupled foot-IMU + GNSS filter (mode tc; also for a mode gnss file) or INS/ZUPT (mode ins)");
   auto config = std::make_shared<std::string>();
   auto out = std::make_shared<std::string>();
   auto mode = std::make_shared<std::string>();

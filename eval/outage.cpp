@@ -28,6 +28,47 @@ Expected<std::vector<OutageWindow>> place_windows_evenly(GpsTime from, GpsTime t
   return w;
 }
 
+double ReferenceCoverage::covered_s(GpsTime start, GpsTime end) const {
+  double covered = 0.0;
+  // The first epoch pair that can reach into [start, end]: the one starting at the last epoch before `start`.
+  auto it = std::lower_bound(epochs.begin(), epochs.end(), start);
+  if (it != epochs.begin()) --it;
+  for (; it != epochs.end() && std::next(it) != epochs.end() && *it < end; ++it) {
+    const GpsTime a = *it, b = *std::next(it);
+    if (b - a > max_gap_s) continue;
+    const GpsTime lo = a < start ? start : a, hi = end < b ? end : b;
+    if (lo < hi) covered += hi - lo;
+  }
+  return covered;
+}
+
+Expected<std::vector<OutageWindow>> place_windows_covered(GpsTime from, GpsTime to, int count, double duration_s,
+                                                          const ReferenceCoverage& reference) {
+  auto centred = place_windows_evenly(from, to, count, duration_s);
+  if (!centred) return centred;
+  const double slot_s = (to - from) / count;
+  std::vector<OutageWindow> w;
+  for (int k = 0; k < count; ++k) {
+    const double centre_s = (*centred)[static_cast<size_t>(k)].start - from;
+    // Whole-second starts (as the centred ones) with the window inside slot k.
+    const double first_s = std::ceil(k * slot_s), last_s = std::floor((k + 1) * slot_s - duration_s);
+    double best_s = centre_s;
+    double best_cover = reference.covered_s(from.plus_s(centre_s), from.plus_s(centre_s + duration_s));
+    for (double s = first_s; s <= last_s; s += 1.0) {
+      const double cover = reference.covered_s(from.plus_s(s), from.plus_s(s + duration_s));
+      // 1 ms: coverage sums of different windows are compared as equal below it (whole-second epochs).
+      constexpr double kSameCover_s = 1e-3;
+      if (cover > best_cover + kSameCover_s ||
+          (std::abs(cover - best_cover) <= kSameCover_s && std::abs(s - centre_s) < std::abs(best_s - centre_s))) {
+        best_s = s;
+        best_cover = cover;
+      }
+    }
+    w.push_back({from.plus_s(best_s), duration_s});
+  }
+  return w;
+}
+
 Expected<std::vector<OutageWindow>> explicit_windows(std::vector<GpsTime> starts, double duration_s) {
   if (starts.empty()) return make_error("outage windows: no start time given");
   if (!(duration_s > 0.0)) return make_error("outage windows: duration must be > 0 s");

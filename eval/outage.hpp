@@ -26,6 +26,23 @@ struct OutageWindow {
 /// and each window is centred in its slot. Fails when the windows do not fit (message gives the available span).
 Expected<std::vector<OutageWindow>> place_windows_evenly(GpsTime from, GpsTime to, int count, double duration_s);
 
+/// Where a reference trajectory can score a solution: its epochs (GPST, increasing) and the largest gap between two
+/// epochs that is still bridged (eval::CompareOptions::max_interp_gap_s: the reference is interpolated across it).
+struct ReferenceCoverage {
+  std::vector<GpsTime> epochs;
+  double max_gap_s = 1.5;
+  /// Seconds of [start, end] covered: the union of the bridged gaps between consecutive epochs, clipped.
+  double covered_s(GpsTime start, GpsTime end) const;
+};
+
+/// `count` windows of `duration_s` in [from, to] where a reference covers them (issue 49 item 8): the span is cut into
+/// `count` equal slots as in place_windows_evenly, and in each slot the window starts at the whole second (counted
+/// from `from`) whose window the reference covers longest; ties go to the start nearest the slot's centred window.
+/// When the reference covers every centred window this is place_windows_evenly. A slot the reference does not reach
+/// keeps its centred window (covered 0 s: the caller reports it as unscorable). Fails as place_windows_evenly does.
+Expected<std::vector<OutageWindow>> place_windows_covered(GpsTime from, GpsTime to, int count, double duration_s,
+                                                          const ReferenceCoverage& reference);
+
 /// Explicit windows (start times in GPST); fails if a window overlaps the next one or the starts are not increasing.
 Expected<std::vector<OutageWindow>> explicit_windows(std::vector<GpsTime> starts, double duration_s);
 

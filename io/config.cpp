@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <set>
 #include <sstream>
 
 #include "io/trajectory_io.hpp"
@@ -13,8 +14,11 @@
 
 namespace pednav::io {
 
-Expected<RunConfig> parse_run_config(const std::string& yaml_text, const std::string& source_name,
-                                     const std::string& base_dir) {
+namespace {
+
+// parse_run_config, also handing out the keys it marked as known (run_config_keys).
+Expected<RunConfig> parse_run_config_keys(const std::string& yaml_text, const std::string& source_name,
+                                          const std::string& base_dir, std::set<std::string>* keys_read) {
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -57,8 +61,35 @@ Expected<RunConfig> parse_run_config(const std::string& yaml_text, const std::st
     }
     top.finish();
   }
+  if (keys_read) keys_read->insert(problems->keys_read.begin(), problems->keys_read.end());
   if (!problems->empty()) return make_error(problems->joined());
   return cfg;
+}
+
+}  // namespace
+
+Expected<RunConfig> parse_run_config(const std::string& yaml_text, const std::string& source_name,
+                                     const std::string& base_dir) {
+  return parse_run_config_keys(yaml_text, source_name, base_dir, nullptr);
+}
+
+std::vector<std::string> run_config_keys() {
+  // Each branch of the reader that only reads keys when a section is there (imu.format as a mapping with its
+  // optional stance/mag/mounting parts, imu.spec as a mapping, an initial position, a fixed SHOE threshold, explicit
+  // scale-factor states). A new optional branch belongs here, or its keys go unchecked.
+  const char* probe = R"(
+base_position_ecef_m: [0, 0, 0]
+imu:
+  format: {stance: {}, mag: {}, mounting_rpy_deg: [0, 0, 0]}
+  spec: {}
+initial: {yaw_deg: 0, position_ecef_m: [0, 0, 0], lat_deg: 0}
+zupt: {shoe_threshold: 1}
+scale_factors: {states: auto}
+reference: {}
+)";
+  std::set<std::string> keys;
+  (void)parse_run_config_keys(probe, "(probe)", ".", &keys);
+  return {keys.begin(), keys.end()};
 }
 
 Expected<RunConfig> load_run_config(const std::string& path) {

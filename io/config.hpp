@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // Run configuration: YAML -> validated options (SI inside; non-SI YAML keys carry their unit suffix).
-// The YAML vocabulary is documented in README.md ("Configuration"). Sections live in io/config_<section>.cpp.
+// The YAML vocabulary is documented in docs/configuration.md (checked against run_config_keys()). Sections live in io/config_<section>.cpp.
 #pragma once
 
 #include <Eigen/Core>
@@ -75,7 +75,7 @@ struct ImuConfig {
   std::string file;
   std::string format_preset;  ///< a preset name from datasets/imu_formats (empty = column map below)
   std::string spec_preset;    ///< IMU noise preset name
-  ImuFormat format;           ///< resolved column map (preset or inline; README "IMU log format")
+  ImuFormat format;           ///< resolved column map (preset or inline; docs/configuration.md "IMU log format")
   ins::ImuSpec spec;          ///< resolved noise model (preset, possibly overridden by inline keys)
   bool has_format = false;    ///< imu.format was given
   bool has_spec = false;      ///< imu.spec was given
@@ -264,6 +264,10 @@ Expected<RunConfig> parse_run_config(const std::string& yaml_text, const std::st
                                      const std::string& base_dir);
 /// The resolved configuration as YAML (written next to the outputs as config.resolved.yaml).
 std::string to_yaml(const RunConfig& config);
+/// Every key path the run configuration reader accepts, sorted ("gnss.ambiguity.partial", "imu.format.time.base",
+/// "imu.spec.gyro_arw_deg_per_sqrt_hr", ...): what the reader marks as known (anything else is an "unknown key")
+/// on probe files that take each of its branches. docs/configuration.md is checked against it.
+std::vector<std::string> run_config_keys();
 
 // Section readers (one file each): read keys of `map` into `out`, reporting problems through `map`.
 void read_gnss_section(YamlMap& top, GnssConfig& out);
@@ -271,9 +275,9 @@ void read_imu_section(YamlMap& top, ImuConfig& out);
 void read_filter_section(YamlMap& top, RunConfig& out);
 /// Read the ARE/MAG/HMM keys of the zupt section (io/hmm_model_io.cpp; loads zupt.hmm_model).
 void read_zupt_hmm_keys(YamlMap& zupt, ZuptConfig& out);
-/// Read an IMU column map (keys of README "IMU log format") from `m` into `out`.
+/// Read an IMU column map (keys of docs/configuration.md "IMU log format") from `m` into `out`.
 void read_imu_format(YamlMap& m, ImuFormat& out);
-/// Read inline IMU spec keys (unit-suffixed, README "IMU spec") from `m` into `out` (SI).
+/// Read inline IMU spec keys (unit-suffixed, docs/configuration.md "IMU spec") from `m` into `out` (SI).
 void read_imu_spec(YamlMap& m, ins::ImuSpec& out);
 /// m[key] as an IMU spec: a preset name, or a map {preset: NAME, <read_imu_spec keys>} overriding the preset's values.
 /// `preset` holds the default preset on entry ("" = none: a map then starts from ins::ImuSpec{}) and the name used on

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // YAML section reader: `imu:` (log file, format = preset name or inline column map, spec = preset name or
-// inline unit-suffixed values). Keys are documented in README ("IMU log format", "IMU spec").
+// inline unit-suffixed values). Keys are documented in docs/configuration.md ("IMU log format", "IMU spec").
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 

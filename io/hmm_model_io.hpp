@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // The HMM zero-velocity detector's model file (hmm.yaml, written by `pednav hmm-train`) and the mapping of the
-// zupt config section onto the detector options. Format: README "HMM model file (hmm.yaml)", docs/zupt.md.
+// zupt config section onto the detector options. Format: docs/zupt.md §4.
 #pragma once
 
 #include <string>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// Generic IMU CSV reader driven by a column map (docs/ins.md §7 and README "IMU log format").
+// Generic IMU CSV reader driven by a column map (docs/ins.md §7 and docs/configuration.md "IMU log format").
 // Messy logs: duplicate time stamps dropped and counted, out-of-order time is an error with file:line, gaps
 // reported and bridged up to a limit, NaN/empty fields and saturated samples reported, unit mistakes caught.
 #pragma once

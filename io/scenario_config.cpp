@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// Scenario YAML reader (README "Scenario files (pednav simulate)"). Unit-suffixed keys are converted to SI here.
+// Scenario YAML reader (docs/configuration.md "Scenario files"). Unit-suffixed keys are converted to SI here.
 #include "io/scenario_config.hpp"
 
 #include "core/rotation.hpp"
@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <set>
 #include <sstream>
 
 #include "core/geodesy.hpp"
@@ -87,10 +88,9 @@ void read_gnss(YamlMap& g, sim::GnssOptions& o) {
   g.number("carrier_half_cycle_s", o.carrier_half_cycle_s, false, 0.001, 3600.0);
 }
 
-}  // namespace
-
-Expected<ScenarioFile> parse_scenario(const std::string& yaml_text, const std::string& source_name,
-                                      const std::string& base_dir) {
+// parse_scenario, also handing out the keys it marked as known (scenario_config_keys).
+Expected<ScenarioFile> parse_scenario_keys(const std::string& yaml_text, const std::string& source_name,
+                                           const std::string& base_dir, std::set<std::string>* keys_read) {
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -295,6 +295,7 @@ Expected<ScenarioFile> parse_scenario(const std::string& yaml_text, const std::s
     }
     top.finish();
   }
+  if (keys_read) keys_read->insert(problems->keys_read.begin(), problems->keys_read.end());
   if (!problems->empty()) return make_error(problems->joined());
   // Geodetic waypoints -> ENU at the origin (the first waypoint when no origin is given).
   if (!geodetic_wp.empty()) {
@@ -319,6 +320,29 @@ Expected<ScenarioFile> parse_scenario(const std::string& yaml_text, const std::s
     out.real_gnss->reference_format = tf->format;
   }
   return out;
+}
+
+}  // namespace
+
+Expected<ScenarioFile> parse_scenario(const std::string& yaml_text, const std::string& source_name,
+                                      const std::string& base_dir) {
+  return parse_scenario_keys(yaml_text, source_name, base_dir, nullptr);
+}
+
+std::vector<std::string> scenario_config_keys() {
+  // The reader's branches: waypoints (ENU and geodetic items), each route shape, the along-a-track mode with a base
+  // position, the optional start/origin/mounting/attenuation parts. A new optional branch belongs here, or its keys
+  // go unchecked. Each probe fails validation (missing required keys) before any file is read.
+  const char* probes[] = {
+      "start: {}\norigin: {}\nroute: {waypoints: [{lat_deg: 0}, {}]}\n"
+      "track: {gnss: {base_position_ecef_m: [0, 0, 0]}}\n"
+      "imu: {spec: {}, mounting_rpy_deg: [0, 0, 0]}\ngnss: {attenuation: [{}]}\n",
+      "route: {shape: {type: circle}}\n",
+      "route: {shape: {type: rectangle}}\n",
+  };
+  std::set<std::string> keys;
+  for (const char* p : probes) (void)parse_scenario_keys(p, "(probe)", ".", &keys);
+  return {keys.begin(), keys.end()};
 }
 
 Expected<ScenarioFile> load_scenario(const std::string& path) {

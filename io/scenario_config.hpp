@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // Simulator scenario files (YAML) -> sim::Scenario, strict (unknown keys, wrong types, out-of-range values are
-// errors, all reported at once). Keys: README "Scenario files (pednav simulate)".
+// errors, all reported at once). Keys: docs/configuration.md "Scenario files".
 #pragma once
 
 #include <optional>
@@ -35,5 +35,9 @@ Expected<ScenarioFile> parse_scenario(const std::string& yaml_text, const std::s
                                       const std::string& base_dir);
 /// Read a scenario file.
 Expected<ScenarioFile> load_scenario(const std::string& path);
+/// Every key path the scenario reader accepts, sorted, list items as "[]" ("route.waypoints[].e_m"): what it marks as
+/// known on probe files that take each of its branches (waypoints, both shapes, a track). docs/configuration.md is
+/// checked against it.
+std::vector<std::string> scenario_config_keys();
 
 }  // namespace pednav::io

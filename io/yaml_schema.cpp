@@ -85,7 +85,17 @@ bool YamlMap::has(const std::string& key) const {
 }
 
 YAML::Node YamlMap::get(const std::string& key, bool required) {
-  known_.insert(key);
+  if (known_.insert(key).second) {
+    // The key's path with list indices written as "[]" ("route.waypoints[3].e_m" -> "route.waypoints[].e_m").
+    std::string p = key_path(key), normalized;
+    for (size_t i = 0; i < p.size(); ++i) {
+      normalized += p[i];
+      if (p[i] == '[') {
+        while (i + 1 < p.size() && p[i + 1] != ']') ++i;
+      }
+    }
+    problems_->keys_read.insert(std::move(normalized));
+  }
   if (!has(key)) {
     if (required) problems_->add(node_, key_path(key), "required key is missing");
     return YAML::Node(YAML::NodeType::Undefined);

@@ -35,6 +35,9 @@ std::vector<std::string> yaml_numbers(std::initializer_list<double> v);
 struct YamlProblems {
   std::string file;
   std::vector<std::string> messages;
+  /// Every key path a YamlMap marked as known while reading ("gnss.ambiguity.partial"; the items of a list as
+  /// "route.waypoints[].e_m"): the vocabulary the reader accepts on the branches the file took.
+  std::set<std::string> keys_read;
   void add(const YAML::Node& where, const std::string& path, const std::string& what);
   bool empty() const { return messages.empty(); }
   std::string joined() const;  ///< one problem per line

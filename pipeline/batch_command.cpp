@@ -82,7 +82,6 @@ Expected<void> run_item(const BatchItem& it, const std::string& out) {
     a.out_dir = out;
     a.keep_sats = it.keep_sats;
     a.plot = false;
-    if (cfg->mode != "tc") cfg->mode = "tc";
     auto r = run_outage_command(*cfg, a);
     if (!r) return r.error();
   }

@@ -37,10 +37,7 @@ using SatKeep = std::map<int64_t, std::vector<gnss::SatId>>;  // rover epoch tim
 // The inputs of a tc run, read once and shared by every window's run.
 using Data = RunInputs;
 
-Expected<Data> load(const RunConfig& c) {
-  if (c.mode != "tc") return make_error(c.source_file + ": mode " + c.mode + ": the outage study needs mode tc (set mode: tc or pass --mode tc)");
-  return load_run_inputs(c);
-}
+Expected<Data> load(const RunConfig& c) { return load_run_inputs(c); }
 
 fusion::EngineInputs inputs(const Data& d) { return d.engine_inputs(); }
 
@@ -125,7 +122,7 @@ Expected<eval::WindowErrors> window_errors(const std::vector<fusion::EpochOutput
   we.window = w;
   if (sol.points.empty()) return we;
   auto ev = eval::compare(sol, reference, eval::CompareOptions{});
-  if (!ev) return make_error("window at " + w.start.to_string() + ": " + ev.error().message);
+  if (!ev) return make_error(ev.error().message);
   for (const auto& e : ev->errors) {
     we.t_since_s.push_back(e.t - w.start);
     we.horizontal_m.push_back(e.horizontal_m);
@@ -165,13 +162,39 @@ std::vector<SolutionRow> solution_rows(const std::vector<fusion::EpochOutput>& e
   return rows;
 }
 
+// Why a reference cannot score window w: the epochs it has around the window, or the comparison's own message.
+std::string unscorable_reason(const eval::Trajectory& reference, const eval::OutageWindow& w,
+                              const std::string& error) {
+  const auto& pts = reference.points;
+  const auto after = std::lower_bound(pts.begin(), pts.end(), w.start,
+                                      [](const eval::TrajectoryPoint& p, GpsTime t) { return p.t < t; });
+  if (after == pts.end() || w.end() < after->t) {
+    const std::string before = after == pts.begin() ? std::string("none") : std::prev(after)->t.to_string();
+    return fmt::format("the reference has no epoch from {} to {} (nearest before: {}; after: {})", w.start.to_string(),
+                       w.end().to_string(), before, after == pts.end() ? std::string("none") : after->t.to_string());
+  }
+  return error;
+}
+
+// A CSV cell of free text: no comma, quote or line break (outages.csv is read by splitting at commas).
+std::string csv_text(std::string s) {
+  for (char& ch : s) {
+    if (ch == ',') ch = ';';
+    if (ch == '"' || ch == '\n' || ch == '\r') ch = ' ';
+  }
+  return s;
+}
+
 // A CSV cell: the value, or empty when there is none (not `have`, or not finite).
 std::string fmt_opt(double v, bool have) { return have && std::isfinite(v) ? fmt::format("{:.3f}", v) : ""; }
 
 }  // namespace
 
-Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& a) {
+Expected<OutageResult> run_outage_command(const RunConfig& given, const OutageArgs& a) {
   const auto wall0 = std::chrono::steady_clock::now();
+  auto as_tc = tc_config(given, "pednav outage");
+  if (!as_tc) return as_tc.error();
+  const RunConfig& c = *as_tc;
   if (a.keep_sats < 0) return make_error("--keep-sats: expected >= 0 (0 = full outage), got " + std::to_string(a.keep_sats));
   if (a.against != "auto" && a.against != "reference" && a.against != "run") {
     return make_error("--against: expected auto, reference or run, got '" + a.against + "'");
@@ -221,8 +244,17 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
                                     a.converged_sigma_yaw_deg));
     }
     spdlog::info("converged at {} (+{:.0f} s settle)", converged->to_string(), a.settle_s);
-    auto w = eval::place_windows_evenly(converged->plus_s(a.settle_s), nominal->epochs.back().t, a.windows,
-                                        a.duration_s);
+    // Against a reference, each window goes where the reference covers it (a real RTK-fixed track has gaps; issue 49
+    // item 8); against the run without outage, which covers everything, evenly.
+    eval::ReferenceCoverage coverage;
+    if (reference) {
+      for (const auto& p : reference->points) coverage.epochs.push_back(p.t);
+      coverage.max_gap_s = eval::CompareOptions{}.max_interp_gap_s;
+    }
+    auto w = reference ? eval::place_windows_covered(converged->plus_s(a.settle_s), nominal->epochs.back().t,
+                                                     a.windows, a.duration_s, coverage)
+                       : eval::place_windows_evenly(converged->plus_s(a.settle_s), nominal->epochs.back().t,
+                                                    a.windows, a.duration_s);
     if (!w) return make_error(c.source_file + ": " + w.error().message);
     res.windows = std::move(*w);
   } else {
@@ -284,6 +316,7 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
 
   // Errors per window: forward and smoothed, against the chosen reference and against the run without outage.
   std::vector<eval::WindowErrors> ef, es, ef_run, es_run;
+  res.unscored_reason.assign(nw, std::string());
   const eval::Trajectory nominal_fwd = to_trajectory(nominal->epochs);
   const eval::Trajectory nominal_smo = to_trajectory(nominal->smoothed);
   for (size_t k = 0; k < nw; ++k) {
@@ -294,8 +327,29 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
     auto add = [&](std::vector<eval::WindowErrors>& dst, const std::vector<fusion::EpochOutput>& sol,
                    const eval::Trajectory& ref) -> Expected<void> {
       auto we = window_errors(sol, ref, res.windows[k]);
-      if (!we) return we.error();
+      if (!we) return make_error("window at " + res.windows[k].start.to_string() + ": " + we.error().message);
       dst.push_back(std::move(*we));
+      return {};
+    };
+    // Against the reference a window may be unscorable (no reference epoch inside it): it is reported with the reason
+    // and left out of the figures, and the study goes on with the other windows.
+    auto add_scored = [&](std::vector<eval::WindowErrors>& dst, const std::vector<fusion::EpochOutput>& sol,
+                          const eval::Trajectory& ref) -> Expected<void> {
+      if (!reference) return add(dst, sol, ref);  // the run without outage covers every window
+      auto we = window_errors(sol, ref, res.windows[k]);
+      if (we && !we->t_since_s.empty()) {
+        dst.push_back(std::move(*we));
+        return {};
+      }
+      if (res.unscored_reason[k].empty()) {
+        res.unscored_reason[k] =
+            unscorable_reason(*reference, res.windows[k],
+                              we ? std::string("no solution epoch inside the window matches the reference")
+                                 : we.error().message);
+      }
+      eval::WindowErrors empty;
+      empty.window = res.windows[k];
+      dst.push_back(std::move(empty));
       return {};
     };
     const bool smoothed = res.has_smoothed && r.summary.smoothed;
@@ -306,8 +360,8 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
     const auto& sol_s = smoothed ? r.smoothed : r.epochs;
     const eval::Trajectory& ref_f = reference ? *reference : nominal_fwd;
     const eval::Trajectory& ref_s = reference ? *reference : (res.has_smoothed ? nominal_smo : nominal_fwd);
-    if (auto ok = add(ef, r.epochs, ref_f); !ok) return ok.error();
-    if (auto ok = add(es, sol_s, ref_s); !ok) return ok.error();
+    if (auto ok = add_scored(ef, r.epochs, ref_f); !ok) return ok.error();
+    if (auto ok = add_scored(es, sol_s, ref_s); !ok) return ok.error();
     if (auto ok = add(ef_run, r.epochs, nominal_fwd); !ok) return ok.error();
     if (auto ok = add(es_run, sol_s, res.has_smoothed ? nominal_smo : nominal_fwd); !ok) return ok.error();
     // Satellites left per masked epoch.
@@ -330,6 +384,12 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
     res.sats_kept_max.push_back(mx);
     res.sats_kept_mean.push_back(n > 0 ? sum / n : 0.0);
   }
+  for (size_t k = 0; k < nw; ++k) {
+    if (!res.unscored_reason[k].empty()) {
+      spdlog::warn("outage window {} ({}): not scored: {}", k + 1, res.windows[k].start.to_string(),
+                   res.unscored_reason[k]);
+    }
+  }
   res.forward = figures(ef);
   res.smoothed = figures(es);
   res.forward_vs_run = figures(ef_run);
@@ -344,7 +404,7 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
       "window,start_gps_week,start_gps_tow_s,duration_s,keep_sats,sats_left_min,sats_left_mean,sats_left_max,"
       "gnss_epochs_emptied,max_error_m,end_error_m,max_error_smoothed_m,end_error_smoothed_m,max_error_vs_run_m,"
       "end_error_vs_run_m,max_error_smoothed_vs_run_m,end_error_smoothed_vs_run_m,"
-      "sigma_at_max_error_m,end_sigma_m,sigma_at_max_error_smoothed_m,end_sigma_smoothed_m\n";
+      "sigma_at_max_error_m,end_sigma_m,sigma_at_max_error_smoothed_m,end_sigma_smoothed_m,scored,unscored_reason\n";
   // Without a smoothed nominal run (smoother off, or re-initialized) the smoothed columns stay empty.
   const bool has_s = res.has_smoothed;
   for (size_t k = 0; k < nw; ++k) {
@@ -352,7 +412,7 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
     const auto& s = res.smoothed.per_window[k];
     const auto& fr = res.forward_vs_run.per_window[k];
     const auto& sr = res.smoothed_vs_run.per_window[k];
-    csv += fmt::format("{},{},{:.3f},{:.3f},{},{},{:.2f},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", k + 1,
+    csv += fmt::format("{},{},{:.3f},{:.3f},{},{},{:.2f},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", k + 1,
                        res.windows[k].start.week(), res.windows[k].start.tow_s(), res.windows[k].duration_s,
                        a.keep_sats, res.sats_kept_min[k], res.sats_kept_mean[k], res.sats_kept_max[k],
                        res.epochs_masked[k], fmt_opt(f.max_m, f.samples > 0), fmt_opt(f.end_m, f.samples > 0),
@@ -361,7 +421,8 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
                        fmt_opt(sr.max_m, has_s && sr.samples > 0), fmt_opt(sr.end_m, has_s && sr.samples > 0),
                        fmt_opt(f.sigma_at_max_m, f.samples > 0), fmt_opt(f.end_sigma_m, f.samples > 0),
                        fmt_opt(s.sigma_at_max_m, has_s && s.samples > 0),
-                       fmt_opt(s.end_sigma_m, has_s && s.samples > 0));
+                       fmt_opt(s.end_sigma_m, has_s && s.samples > 0), res.unscored_reason[k].empty() ? 1 : 0,
+                       csv_text(res.unscored_reason[k]));
   }
   if (auto ok = write_file_atomic((out / "outages.csv").string(), csv); !ok) return ok.error();
   if (a.write_runs) {
@@ -438,21 +499,26 @@ Expected<OutageResult> run_outage_command(const RunConfig& c, const OutageArgs& 
   j["outage"] = a.keep_sats == 0 ? "full" : "partial";
   j["keep_by"] = a.keep_by == eval::KeepBy::kCn0 ? "cn0" : "elevation";
   j["against"] = res.against;
+  j["windows_unscored"] = std::count_if(res.unscored_reason.begin(), res.unscored_reason.end(),
+                                        [](const std::string& r) { return !r.empty(); });
   if (reference) j["reference"] = c.reference.file;
   if (res.has_smoothed) j["smoothed"] = figures_json(res.smoothed);
   j["vs_run_without_outage"] = {{"forward", figures_json(res.forward_vs_run)}};
   if (res.has_smoothed) j["vs_run_without_outage"]["smoothed"] = figures_json(res.smoothed_vs_run);
   nlohmann::ordered_json wl = nlohmann::json::array();
   for (size_t k = 0; k < nw; ++k) {
+    const bool scored = res.unscored_reason[k].empty();
     wl.push_back({{"start_gps_week", res.windows[k].start.week()},
                   {"start_gps_tow_s", res.windows[k].start.tow_s()},
-                  {"max_error_m", res.forward.per_window[k].max_m},
-                  {"end_error_m", res.forward.per_window[k].end_m},
+                  {"max_error_m", scored ? nlohmann::json(res.forward.per_window[k].max_m) : nlohmann::json()},
+                  {"end_error_m", scored ? nlohmann::json(res.forward.per_window[k].end_m) : nlohmann::json()},
                   {"sats_left_mean", res.sats_kept_mean[k]}});
     // The forward filter's own horizontal 1σ beside its errors (absent when the solution carries no covariance).
     const auto& f = res.forward.per_window[k];
     if (std::isfinite(f.sigma_at_max_m)) wl.back()["sigma_at_max_error_m"] = f.sigma_at_max_m;
     if (std::isfinite(f.end_sigma_m)) wl.back()["end_sigma_m"] = f.end_sigma_m;
+    wl.back()["scored"] = scored;
+    if (!scored) wl.back()["unscored_reason"] = res.unscored_reason[k];
   }
   j["window_list"] = wl;
   j["config"] = c.source_file;

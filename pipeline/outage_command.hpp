@@ -48,9 +48,13 @@ struct OutageResult {
   std::vector<double> sats_kept_mean;       ///< per window: mean satellites left per masked epoch
   std::vector<int> sats_kept_min, sats_kept_max;
   std::vector<long> epochs_masked;          ///< per window: engine's count of epochs emptied by the mask
+  /// Per window: why the reference could not score it ("" = scored). Such a window has no sample in `forward` and
+  /// `smoothed` (its figures against the run without outage remain).
+  std::vector<std::string> unscored_reason;
 };
 
-/// Run the study for a loaded configuration (mode tc) and write the outputs into args.out_dir.
+/// Run the study for a loaded configuration and write the outputs into args.out_dir. The study is of the tightly
+/// coupled filter: a configuration of another mode runs as tc when it has the IMU log and the GNSS files.
 Expected<OutageResult> run_outage_command(const io::RunConfig& config, const OutageArgs& args);
 
 }  // namespace pednav::pipeline

@@ -317,14 +317,34 @@ Expected<RunInputs> load_run_inputs(const RunConfig& c, const ImuLog* given_imu)
   return d;
 }
 
-std::string run_mode_problem(const RunConfig& c) {
-  return c.mode == "gnss" ? c.source_file + ": mode gnss: use `pednav gnss` (run handles tc and ins)" : "";
+Expected<RunConfig> tc_config(const RunConfig& c, const std::string& command) {
+  if (c.mode == "tc") return c;
+  std::string missing;
+  for (const auto& [key, absent] : {std::pair<const char*, bool>{"imu.file", c.imu.file.empty()},
+                                    {"rover_obs", c.gnss.rover_obs.empty()}, {"nav", c.gnss.nav.empty()}}) {
+    if (absent) missing += std::string(missing.empty() ? "" : ", ") + key;
+  }
+  if (!missing.empty()) {
+    return make_error(fmt::format("{}: mode {}: {} runs the tightly coupled filter, which needs {} (missing here){}",
+                                  c.source_file, c.mode, command, missing,
+                                  c.imu.file.empty() ? "; `pednav gnss` gives the GNSS-only solution" : ""));
+  }
+  spdlog::info("{}: mode {}: {} runs the tightly coupled filter (mode tc) on its IMU log and GNSS files",
+               c.source_file, c.mode, command);
+  RunConfig t = c;
+  t.mode = "tc";
+  return t;
+}
+
+Expected<RunConfig> run_config_for_mode(const RunConfig& c) {
+  if (c.mode == "gnss") return tc_config(c, "pednav run");
+  return c;
 }
 
 Expected<RunOutputs> compute_run(const RunConfig& c, const RunInputs& data, std::function<bool(GpsTime)> cancel,
                                  const std::string& out_dir) {
   const auto wall0 = std::chrono::steady_clock::now();
-  if (const std::string p = run_mode_problem(c); !p.empty()) return make_error(p);
+  if (c.mode == "gnss") return make_error(c.source_file + ": mode gnss: compute_run needs run_config_for_mode first");
   RunOutputs outputs;
   const ImuLog* imu = &data.imu;
   const std::optional<gnss::ObsData>& base = data.base;
@@ -485,9 +505,11 @@ Expected<RunOutputs> compute_run(const RunConfig& c, const RunInputs& data, std:
   return outputs;
 }
 
-Expected<fusion::EngineSummary> run_run_command(const RunConfig& c, const std::string& out_dir) {
+Expected<fusion::EngineSummary> run_run_command(const RunConfig& given, const std::string& out_dir) {
   const auto wall0 = std::chrono::steady_clock::now();
-  if (const std::string p = run_mode_problem(c); !p.empty()) return make_error(p);
+  auto as_run = run_config_for_mode(given);
+  if (!as_run) return as_run.error();
+  const RunConfig& c = *as_run;
   auto loaded = load_run_inputs(c);
   if (!loaded) return loaded.error();
   auto computed = compute_run(c, *loaded, {}, out_dir);

@@ -53,8 +53,15 @@ Expected<RunInputs> load_run_inputs(const io::RunConfig& config, const io::ImuLo
 /// with satellites used, else 5).
 io::SolutionRow solution_row(const fusion::EpochOutput& e);
 
-/// The error `pednav run` gives for the configuration's mode before reading anything (mode gnss); empty: none.
-std::string run_mode_problem(const io::RunConfig& config);
+/// The configuration as the tightly coupled filter runs it (issue 49 item 8: every command takes any configuration
+/// that has what it needs): mode tc as it is; another mode (a file written for `pednav gnss`, or an INS/ZUPT one with
+/// GNSS files) with mode tc when it has the IMU log and the GNSS files, else an error naming the configuration, its
+/// mode and the missing keys. `command` names the caller in messages ("pednav outage").
+Expected<io::RunConfig> tc_config(const io::RunConfig& config, const std::string& command);
+
+/// The configuration `pednav run` runs (before reading anything): mode tc and ins as they are, mode gnss through
+/// tc_config (an error when it lacks the IMU log or the GNSS files).
+Expected<io::RunConfig> run_config_for_mode(const io::RunConfig& config);
 
 /// Everything `pednav run` computes before it writes a file (the Python module returns it in memory).
 struct RunOutputs {
@@ -80,7 +87,8 @@ Expected<RunOutputs> compute_run(const io::RunConfig& config, const RunInputs& d
 Expected<void> write_run_outputs(const io::RunConfig& config, RunOutputs& outputs, const std::string& out_dir,
                                  std::optional<std::chrono::steady_clock::time_point> wall0 = std::nullopt);
 
-/// Run `pednav run` for a loaded configuration and write the outputs into out_dir (created).
+/// Run `pednav run` for a loaded configuration and write the outputs into out_dir (created). Mode tc and ins run as
+/// they are; a mode gnss configuration runs the tc filter (tc_config) when it has the IMU log and the GNSS files.
 Expected<fusion::EngineSummary> run_run_command(const io::RunConfig& config, const std::string& out_dir);
 
 }  // namespace pednav::pipeline

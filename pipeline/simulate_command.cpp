@@ -109,8 +109,8 @@ std::string format_config(const sim::Simulation& s, const ScenarioFile& f, const
          "# --multipath-states, where they apply to this scenario; docs/sim.md §7, docs/consistency.md §3.8-3.11).\n";
     y += any_gnss ? "mode: tc\n" : "mode: ins\n";
   } else if (any_gnss) {
-    y += "# mode gnss: for `pednav gnss` (GNSS epochs by least squares); `pednav run --mode tc` (or mode: tc) runs the\n"
-         "# tightly coupled filter.\nmode: gnss\n";
+    y += "# mode tc: `pednav run` runs the tightly coupled filter; `pednav gnss` (GNSS epochs by least squares) and\n"
+         "# `pednav outage` take this file as it is.\nmode: tc\n";
   } else {
     y += "mode: ins\n";
   }

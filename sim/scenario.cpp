@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// Scenario validation: every problem at once, named by the YAML key it comes from (README "Scenario files").
+// Scenario validation: every problem at once, named by the YAML key it comes from (docs/configuration.md
+// "Scenario files").
 #include "sim/scenario.hpp"
 
 #include <cmath>

@@ -379,7 +379,11 @@ Result run(const Config& config, const std::optional<ImuLog>& imu, const std::op
     if (*mode != "tc" && *mode != "ins") raise(PyExc_ValueError, "mode: " + *mode + " (tc or ins expected)");
     c.mode = *mode;
   }
-  if (const std::string p = pipeline::run_mode_problem(c); !p.empty()) raise(PyExc_ValueError, p);
+  if (auto as_run = pipeline::run_config_for_mode(c); !as_run) {
+    raise(PyExc_ValueError, as_run.error().message);
+  } else {
+    c = *as_run;
+  }
   if (!imu) {
     if (auto missing = io::missing_input_files(c); !missing.empty()) {
       std::string all;

@@ -36,7 +36,7 @@ def square(tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def forest_result(forest):
-    """pednav.run on the forest walk's config.yaml in mode tc (the simulator writes mode gnss)."""
+    """pednav.run on the forest walk's config.yaml in mode tc."""
     return pednav.run(forest["config"], mode="tc")
 
 

@@ -216,12 +216,16 @@ TEST(RunCommandBadInput, ImuLogWithoutAStillPeriodNamesTheConfig) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(RunCommandBadInput, ModeGnssIsRedirected) {
+// A mode gnss file without an IMU log: run names what it lacks and where the GNSS-only solution is (issue 49 item 8:
+// with the IMU log it runs as tc, tests/apps/scenario_obvious_next_command.cpp).
+TEST(RunCommandBadInput, ModeGnssWithoutImuSaysWhatIsMissing) {
   auto c = io::parse_run_config("mode: gnss\nrover_obs: r.obs\nnav: n.rnx\n", "run.yaml", "/data");
   ASSERT_TRUE(c) << c.error().message;
   auto r = pipeline::run_run_command(*c, "/nonexistent/out");
   ASSERT_FALSE(r);
-  EXPECT_THAT(r.error().message, HasSubstr("mode gnss: use `pednav gnss`"));
+  EXPECT_THAT(r.error().message,
+              HasSubstr("run.yaml: mode gnss: pednav run runs the tightly coupled filter, which needs imu.file "
+                        "(missing here); `pednav gnss` gives the GNSS-only solution"));
 }
 
 }  // namespace

@@ -88,7 +88,8 @@ TEST_F(OutageCommand, PartialKeepsAtMostNSatellitesAndWritesTheDesignOutputs) {
   const std::string csv = test::read_text(a.out_dir + "/outages.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), kWindows + 1);
   EXPECT_THAT(csv.substr(0, csv.find('\n')),
-              ::testing::EndsWith(",sigma_at_max_error_m,end_sigma_m,sigma_at_max_error_smoothed_m,end_sigma_smoothed_m"));
+              ::testing::EndsWith(",sigma_at_max_error_m,end_sigma_m,sigma_at_max_error_smoothed_m,"
+                                   "end_sigma_smoothed_m,scored,unscored_reason"));
   auto j = nlohmann::json::parse(test::read_text(a.out_dir + "/summary.json"));
   // The forward filter's own horizontal σ beside its errors: positive, bounded, and the solution's σ rather than a
   // copy of the error.
@@ -144,7 +145,9 @@ TEST_F(OutageCommand, SmoothedColumnsAreEmptyWithoutASmoother) {
     if (e == std::string::npos) e = row.size();
     cells.push_back(row.substr(b, e - b));
   }
-  ASSERT_EQ(cells.size(), 21u) << row;
+  ASSERT_EQ(cells.size(), 23u) << row;
+  EXPECT_EQ(cells[21], "1") << "scored";
+  EXPECT_EQ(cells[22], "") << "no reason";
   EXPECT_FALSE(cells[9].empty()) << "forward max error";
   EXPECT_FALSE(cells[17].empty()) << "forward sigma at the max error";
   for (int i : {11, 12, 15, 16, 19, 20}) EXPECT_TRUE(cells[i].empty()) << "column " << i << " of " << row;

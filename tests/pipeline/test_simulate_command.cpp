@@ -47,7 +47,7 @@ TEST(SimulateCommand, ConfigYamlIsARunConfigurationOnTheWrittenFiles) {
   ASSERT_TRUE(pipeline::run_simulate_command(short_walk(3), d).has_value());
   auto cfg = io::load_run_config(d + "/config.yaml");
   ASSERT_TRUE(cfg.has_value()) << (cfg ? "" : cfg.error().message);
-  EXPECT_EQ(cfg->mode, "gnss");
+  EXPECT_EQ(cfg->mode, "tc") << "the main job's mode (issue 49 item 8)";
   EXPECT_TRUE(std::filesystem::exists(cfg->gnss.rover_obs)) << cfg->gnss.rover_obs;
   EXPECT_TRUE(std::filesystem::exists(cfg->gnss.base_obs));
   ASSERT_EQ(cfg->gnss.nav.size(), 1u);
