@@ -10,7 +10,7 @@ PYSHOE_CONFIG = SOURCE_DIR / "datasets" / "foot" / "pyshoe_auto.yaml"
 
 def test_from_yaml_reads_the_simulated_config(forest):
     c = pednav.Config.from_yaml(forest["files"]["config"])
-    assert c.mode == "gnss"  # the simulator's config.yaml (pednav run --mode tc)
+    assert c.mode == "tc"  # the simulator's config.yaml (the main job's mode)
     assert c.source_file == forest["files"]["config"]
     # The resolved YAML is what `pednav config-check` prints.
     assert c.to_yaml() == cli("config-check", forest["files"]["config"]).stdout
@@ -19,7 +19,7 @@ def test_from_yaml_reads_the_simulated_config(forest):
 def test_to_dict_round_trip(forest):
     c = pednav.Config.from_yaml(forest["files"]["config"])
     d = c.to_dict()
-    assert d["mode"] == "gnss"
+    assert d["mode"] == "tc"
     assert isinstance(d["mechanization_rate_hz"], float) or isinstance(d["mechanization_rate_hz"], int)
     again = pednav.Config.from_dict(d)
     assert again.to_yaml() == c.to_yaml()
