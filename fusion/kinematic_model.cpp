@@ -2,6 +2,7 @@
 // Shared pieces of the GNSS-only kinematic filters (fusion/kinematic_model.hpp).
 #include "fusion/kinematic_model.hpp"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 
 #include "core/geodesy.hpp"
@@ -23,6 +24,24 @@ void predict_white_acceleration(Eigen::VectorXd& x, Eigen::MatrixXd& P, double d
   P.block<3, 3>(0, 3) += Qa * dt * dt / 2.0;
   P.block<3, 3>(3, 0) += Qa * dt * dt / 2.0;
   P.block<3, 3>(3, 3) += Qa * dt;
+}
+
+bool w_test_pass_solve(const Eigen::MatrixXd& P, WTestPass& pass) {
+  const int m = static_cast<int>(pass.act.size());
+  pass.PHt = P * pass.H.transpose();
+  Eigen::MatrixXd S = pass.H * pass.PHt;
+  S.diagonal() += pass.R;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
+  if (ldlt.info() != Eigen::Success) return false;
+  pass.Sinv = ldlt.solve(Eigen::MatrixXd::Identity(m, m));
+  return true;
+}
+
+void joseph_update(const Eigen::MatrixXd& P, const WTestPass& pass, Eigen::VectorXd& dx, Eigen::MatrixXd& P_post) {
+  const Eigen::MatrixXd K = pass.PHt * pass.Sinv;
+  dx = K * pass.r;
+  const Eigen::MatrixXd IKH = Eigen::MatrixXd::Identity(P.rows(), P.cols()) - K * pass.H;
+  P_post = IKH * P * IKH.transpose() + K * pass.R.asDiagonal() * K.transpose();
 }
 
 double median_of(std::vector<double> v) {

@@ -334,26 +334,16 @@ RtkEpoch RtkFilter::process(const gnss::ObsEpoch& rover, int base_index) {
   VectorXd dx;
   MatrixXd P_post;
   int held_slips = 0;
+  WTestPass pass;
   for (size_t iter = 0; iter <= rows.size(); ++iter) {
-    std::vector<int> act;
-    for (size_t i = 0; i < rows.size(); ++i) if (rows[i].active) act.push_back(static_cast<int>(i));
-    const int m = static_cast<int>(act.size());
-    MatrixXd H(m, n);
-    VectorXd r(m), R(m);
-    for (int i = 0; i < m; ++i) {
-      H.row(i) = rows[act[i]].h;
-      r(i) = rows[act[i]].residual;
-      R(i) = rows[act[i]].sigma * rows[act[i]].sigma;
-    }
-    const MatrixXd PHt = P_ * H.transpose();
-    MatrixXd S = H * PHt;
-    S.diagonal() += R;
-    const Eigen::LDLT<MatrixXd> ldlt(S);
-    if (ldlt.info() != Eigen::Success) {
+    if (!w_test_pass(rows, P_, pass)) {
       ++sum_.none;
       return out;
     }
-    const MatrixXd Sinv = ldlt.solve(MatrixXd::Identity(m, m));
+    const std::vector<int>& act = pass.act;
+    const int m = static_cast<int>(act.size());
+    const VectorXd& r = pass.r;
+    const MatrixXd& Sinv = pass.Sinv;
     const VectorXd t = Sinv * r;
     int worst = -1;
     double worst_w = w_crit;
@@ -384,10 +374,7 @@ RtkEpoch RtkFilter::process(const gnss::ObsEpoch& rover, int base_index) {
       }
       continue;
     }
-    const MatrixXd K = PHt * Sinv;
-    dx = K * r;
-    const MatrixXd IKH = MatrixXd::Identity(n, n) - K * H;
-    P_post = IKH * P_ * IKH.transpose() + K * R.asDiagonal() * K.transpose();
+    joseph_update(P_, pass, dx, P_post);
     break;
   }
   if (dx.size() != n) {
