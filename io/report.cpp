@@ -207,6 +207,7 @@ Expected<ReportResult> run_report_command(const std::string& run_dir) {
   html += "<p class=\"meta\">Run folder: <code>" + esc(fs::absolute(dir).string()) + "</code> · <span id=\"plot-status\">plots: " +
           std::to_string(h.plots + topics.plots) + " embedded</span> · <span id=\"layout-status\">layout: not checked</span></p>\n";
   html += headline(dir, summary);
+  html += fit_warnings_html(summary);
   html += h.body;
   html += topics.body;
   html += appendix_html(summary);

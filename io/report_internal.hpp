@@ -103,6 +103,8 @@ std::string share(long long n, long long of);
 
 /// One sentence at the top: the accuracy of each solution against the reference and the filter's health.
 std::string headline(const fs::path& dir, const nlohmann::json& summary);
+/// The run's fit warnings (summary.json `warnings`) as a list under the headline; "" without any.
+std::string fit_warnings_html(const nlohmann::json& summary);
 /// Accuracy against the reference: seed 004's bins (Tables 1-2), then the statistics, one row per solution.
 void evaluation_section(Html& h, const fs::path& dir);
 /// Health of the run: what was rejected, re-initialized, skipped; then the report's own warnings.

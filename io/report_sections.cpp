@@ -40,6 +40,19 @@ std::string headline(const fs::path& dir, const nlohmann::json& summary) {
   return s.empty() ? "" : "<p class=\"headline\" id=\"headline\">" + esc(s) + ".</p>\n";
 }
 
+// The run's fit warnings (summary.json `warnings`, docs/fusion.md §15) under the headline; nothing without any.
+std::string fit_warnings_html(const nlohmann::json& summary) {
+  const auto* w = summary.is_null() ? nullptr : at_path(summary, "warnings");
+  if (!w || !w->is_array() || w->empty()) return "";
+  std::string h = "<div class=\"warn\" id=\"fit-warnings\"><p>The log does not fit the model here:</p><ul>\n";
+  for (const auto& x : *w) {
+    const std::string msg = x.contains("message") && x["message"].is_string() ? x["message"].get<std::string>() : "";
+    const std::string hint = x.contains("hint") && x["hint"].is_string() ? x["hint"].get<std::string>() : "";
+    h += "<li>" + esc(msg) + (hint.empty() ? "" : ": " + esc(hint)) + "</li>\n";
+  }
+  return h + "</ul></div>\n";
+}
+
 // Accuracy against the reference: seed 004's bins (Tables 1-2), then the statistics, one row per solution.
 void evaluation_section(Html& h, const fs::path& dir) {
   std::vector<std::vector<std::string>> rows;

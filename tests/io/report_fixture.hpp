@@ -56,6 +56,8 @@ inline void write_report_fixture(const std::string& dir) {
          "\"gnss\": {\"epochs_read\": 300, \"epochs_skipped_no_base\": 2, \"epochs_outside_imu_span\": 0, "
          "\"code\": {\"below_elevation_mask\": 30, \"innovation_fault\": 6, \"persistent_fault\": 1, \"used\": 1763}, "
          "\"doppler\": {\"innovation_fault\": 0, \"used\": 1800}}, "
+         "\"warnings\": [{\"code\": \"gyro_bias\", \"message\": \"gyro bias estimate 958.0 °/h is beyond 3 σ of the spec "
+         "(144.2 °/h)\", \"value\": 958.0, \"limit\": 432.6, \"hint\": \"try imu.spec: auto\"}], "
          "\"health\": {\"healthy\": true, \"reinitializations\": 1, "
          "\"events\": [\"re-initialized at 225120.0 s: speed 12.3 m/s\"]}, "
          "\"accounting\": {\"imu_samples\": {\"read\": 30000, \"used\": 29990, \"rejected\": {\"nan\": 4}, "

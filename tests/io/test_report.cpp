@@ -88,6 +88,11 @@ TEST(Report, RunFolderGivesSelfContainedHtmlWithEveryPlot) {
   EXPECT_THAT(html, HasSubstr("Smoothed horizontal RMS 0.14 m (max 0.20 m); forward horizontal RMS 0.35 m (max 0.50 m). "
                               "Filter healthy, 1 re-initialization."));
   EXPECT_LT(html.find("id=\"headline\""), html.find("<h2>Accuracy against the reference</h2>"));
+  // The run's fit warnings (summary.json `warnings`, docs/fusion.md §15) right under the headline.
+  EXPECT_THAT(html, HasSubstr("<li>gyro bias estimate 958.0 °/h is beyond 3 σ of the spec (144.2 °/h): try imu.spec: "
+                              "auto</li>"));
+  EXPECT_LT(html.find("id=\"headline\""), html.find("id=\"fit-warnings\""));
+  EXPECT_LT(html.find("id=\"fit-warnings\""), html.find("<h2>Accuracy against the reference</h2>"));
   EXPECT_LT(html.find("<h2>Health</h2>"), html.find("data:image/svg+xml"));
   EXPECT_THAT(html, HasSubstr("<th>GNSS code rejected by fault detection</th><td>7 of 1800 (0.4 %), 1 of them as "
                               "persistent faults</td>"));
