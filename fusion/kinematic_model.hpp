@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <vector>
 
 #include "gnss/types.hpp"
@@ -24,6 +25,20 @@ struct WTestPass {
   Eigen::VectorXd r, R;
 };
 bool w_test_pass_solve(const Eigen::MatrixXd& P, WTestPass& pass);
+/// The active row (index into pass.act) with the largest w = |(S⁻¹r)_i| / √(S⁻¹)_ii above w_crit, skipping those
+/// skip(row index) marks; −1 when none is above.
+template <typename Skip>
+int w_test_worst(const WTestPass& pass, double w_crit, Skip skip) {
+  const Eigen::VectorXd t = pass.Sinv * pass.r;
+  int worst = -1;
+  double worst_w = w_crit;
+  for (int i = 0; i < static_cast<int>(pass.act.size()); ++i) {
+    if (skip(pass.act[i])) continue;
+    const double w = std::abs(t(i)) / std::sqrt(pass.Sinv(i, i));
+    if (w > worst_w) worst_w = w, worst = i;
+  }
+  return worst;
+}
 template <typename Row>
 bool w_test_pass(const std::vector<Row>& rows, const Eigen::MatrixXd& P, WTestPass& pass) {
   pass.act.clear();

@@ -342,16 +342,7 @@ RtkEpoch RtkFilter::process(const gnss::ObsEpoch& rover, int base_index) {
     }
     const std::vector<int>& act = pass.act;
     const int m = static_cast<int>(act.size());
-    const VectorXd& r = pass.r;
-    const MatrixXd& Sinv = pass.Sinv;
-    const VectorXd t = Sinv * r;
-    int worst = -1;
-    double worst_w = w_crit;
-    for (int i = 0; i < m; ++i) {
-      if (rows[act[i]].tested_out) continue;
-      const double w = std::abs(t(i)) / std::sqrt(Sinv(i, i));
-      if (w > worst_w) worst_w = w, worst = i;
-    }
+    const int worst = w_test_worst(pass, w_crit, [&](int k) { return rows[k].tested_out; });
     if (worst >= 0 && m > 4) {
       Row& bad = rows[act[worst]];
       if (bad.kind == Row::kPhase) {

@@ -230,15 +230,7 @@ TdcpEpoch TdcpFilter::process(const gnss::ObsEpoch& rover, bool use_code) {
     if (!w_test_pass(rows, P_, pass)) break;
     const std::vector<int>& act = pass.act;
     const int m = static_cast<int>(act.size());
-    const VectorXd& r = pass.r;
-    const MatrixXd& Sinv = pass.Sinv;
-    const VectorXd t = Sinv * r;
-    int worst = -1;
-    double worst_w = w_crit;
-    for (int i = 0; i < m; ++i) {
-      const double w = std::abs(t(i)) / std::sqrt(Sinv(i, i));
-      if (w > worst_w) worst_w = w, worst = i;
-    }
+    const int worst = w_test_worst(pass, w_crit, [](int) { return false; });
     if (worst >= 0 && m > 4) {
       Row& bad = rows[act[worst]];
       bad.active = false;
