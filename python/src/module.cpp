@@ -15,12 +15,12 @@
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <cctype>
 #include <chrono>
 #include <filesystem>
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <regex>
 #include <string>
 
 #include "eval/statistics.hpp"
@@ -88,14 +88,33 @@ Config config_from_yaml(const py::object& path_obj) {
   return Config{std::make_shared<const io::RunConfig>(std::move(*c))};
 }
 
+// "config:<digits>: " at the start of a line → "config: ".
+std::string drop_config_line_numbers(const std::string& message) {
+  std::string out;
+  size_t i = 0;
+  while (i < message.size()) {
+    const size_t eol = message.find('\n', i);
+    std::string line = message.substr(i, eol == std::string::npos ? std::string::npos : eol - i + 1);
+    const std::string lead = "config:";
+    if (line.compare(0, lead.size(), lead) == 0) {
+      size_t d = lead.size();
+      while (d < line.size() && std::isdigit(static_cast<unsigned char>(line[d]))) ++d;
+      if (d > lead.size() && line.compare(d, 2, ": ") == 0) line = "config: " + line.substr(d + 2);
+    }
+    out += line;
+    if (eol == std::string::npos) break;
+    i = eol + 1;
+  }
+  return out;
+}
+
 Config config_from_dict(const py::dict& d, const std::optional<std::string>& base_dir) {
   const std::string text = py_to_yaml(d, "");
   const std::string dir = base_dir ? *base_dir : fs::current_path().string();
   auto c = io::parse_run_config(text, "config", dir);
   if (!c) {
     // The messages name the key path; the line numbers would be those of the YAML made from the dict: dropped.
-    static const std::regex kLine(R"((^|\n)config:\d+: )");
-    raise(PyExc_ValueError, std::regex_replace(c.error().message, kLine, "$1config: "));
+    raise(PyExc_ValueError, drop_config_line_numbers(c.error().message));
   }
   check_config(*c);
   return Config{std::make_shared<const io::RunConfig>(std::move(*c))};

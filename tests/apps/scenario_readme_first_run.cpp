@@ -10,7 +10,6 @@
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <regex>
 #include <string>
 
 #include "io/scenario_config.hpp"
@@ -31,9 +30,13 @@ std::string fenced_block(const std::string& readme, const std::string& begin) {
 
 // "<which> vs reference: horizontal RMS X m" in the README's console block: X, or -1.
 double readme_rms(const std::string& console, const std::string& which) {
-  std::smatch m;
-  const std::regex re(which + " vs reference: horizontal RMS ([0-9.]+) m");
-  return std::regex_search(console, m, re) ? std::stod(m[1]) : -1.0;
+  const std::string lead = which + " vs reference: horizontal RMS ";
+  const size_t at = console.find(lead);
+  if (at == std::string::npos) return -1.0;
+  const size_t b = at + lead.size();
+  const size_t e = console.find_first_not_of("0123456789.", b);
+  if (e == b || e == std::string::npos || console.compare(e, 2, " m") != 0) return -1.0;
+  return std::stod(console.substr(b, e - b));
 }
 
 TEST(ReadmeFirstRun, TheMinimalConfigurationRunsAndPrintsWhatTheReadmeShows) {

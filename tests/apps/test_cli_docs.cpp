@@ -4,9 +4,10 @@
 // every flag in such a first column is one that `pednav NAME --help` lists; the same for the global options.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <map>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -70,24 +71,42 @@ std::set<std::string> help_subcommands(const std::string& help) {
 }
 
 // The flags in the first cells of docs/cli.md's tables, per section: "global" or the subcommand's name.
+// "<prefix><name><suffix>" with name of [a-z-]+: the name, or "". (Hand-written matchers: GCC 12's std::regex
+// trips -Wmaybe-uninitialized under ASan -O2.)
+std::string command_name(const std::string& s, const std::string& prefix, const std::string& suffix) {
+  if (s.size() <= prefix.size() + suffix.size() || s.compare(0, prefix.size(), prefix) != 0 ||
+      s.compare(s.size() - suffix.size(), suffix.size(), suffix) != 0) {
+    return "";
+  }
+  const std::string name = s.substr(prefix.size(), s.size() - prefix.size() - suffix.size());
+  for (const char c : name) {
+    if (!((c >= 'a' && c <= 'z') || c == '-')) return "";
+  }
+  return name;
+}
+
+// -x or --name with [A-Za-z][A-Za-z0-9-]* after the dashes.
+bool is_flag(const std::string& w) {
+  const size_t dashes = w.compare(0, 2, "--") == 0 ? 2 : (w.compare(0, 1, "-") == 0 ? 1 : 0);
+  if (dashes == 0 || w.size() == dashes || !std::isalpha(static_cast<unsigned char>(w[dashes]))) return false;
+  for (size_t i = dashes; i < w.size(); ++i) {
+    if (!(std::isalnum(static_cast<unsigned char>(w[i])) || w[i] == '-')) return false;
+  }
+  return true;
+}
+
 std::map<std::string, std::set<std::string>> documented_flags(const std::string& markdown) {
-  const std::regex command_heading("^`pednav ([a-z-]+)`$");
-  const std::regex flag("^--?[A-Za-z][A-Za-z0-9-]*$");
   std::map<std::string, std::set<std::string>> out;
   for (const auto& row : test::doc_table_rows(markdown)) {
-    std::smatch m;
-    std::string where;
-    if (std::regex_match(row.section, m, command_heading)) {
-      where = m[1];
-    } else if (row.section == "Global options") {
-      where = "global";
-    } else {
-      continue;
-    }
+    std::string where = command_name(row.section, "`pednav ", "`");
+    if (where.empty() && row.section == "Global options") where = "global";
+    if (where.empty()) continue;
     for (const std::string& code : row.codes) {
-      std::istringstream words(std::regex_replace(code, std::regex(","), " "));
+      std::string spaced = code;
+      std::replace(spaced.begin(), spaced.end(), ',', ' ');
+      std::istringstream words(spaced);
       for (std::string w; words >> w;) {
-        if (std::regex_match(w, flag)) out[where].insert(w);
+        if (is_flag(w)) out[where].insert(w);
       }
     }
   }
@@ -97,10 +116,9 @@ std::map<std::string, std::set<std::string>> documented_flags(const std::string&
 std::set<std::string> documented_commands(const std::string& markdown) {
   std::set<std::string> names;
   std::istringstream in(markdown);
-  const std::regex heading("^## `pednav ([a-z-]+)`$");
-  std::smatch m;
   for (std::string line; std::getline(in, line);) {
-    if (std::regex_match(line, m, heading)) names.insert(m[1]);
+    const std::string name = command_name(line, "## `pednav ", "`");
+    if (!name.empty()) names.insert(name);
   }
   return names;
 }
