@@ -16,7 +16,9 @@ namespace pednav::ins {
 struct StillnessOptions {
   double max_gyro_std_radps = 0.05;    ///< per-axis standard deviation of the rate [rad/s]
   double max_accel_std_mps2 = 0.15;    ///< per-axis standard deviation of the specific force [m/s^2]
-  double max_gravity_error_mps2 = 0.5; ///< | |mean f| - |g| | allowed [m/s^2]
+  /// | |mean f| - |g| | allowed [m/s^2]: a unit or scale check. 1.5 m/s² (≈ 150 mg) admits the zero-g offsets of
+  /// consumer accelerometers (tens of mg, up to ~100 mg on some axes), which a sensor nobody calibrated brings.
+  double max_gravity_error_mps2 = 1.5;
   double min_duration_s = 0.5;         ///< shortest usable window [s]
 };
 

@@ -16,6 +16,20 @@ namespace pednav::io {
 
 namespace {
 
+// A path as the resolved configuration writes it: absolute, so that the file reads back from any folder (paths in a
+// configuration are relative to the configuration's own folder, and config.resolved.yaml lives in the output folder).
+std::string absolute_path(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::path a = std::filesystem::absolute(path, ec);
+  return ec ? path : a.lexically_normal().string();
+}
+
+std::vector<std::string> absolute_paths(const std::vector<std::string>& paths) {
+  std::vector<std::string> out;
+  for (const auto& p : paths) out.push_back(absolute_path(p));
+  return out;
+}
+
 // parse_run_config, also handing out the keys it marked as known (run_config_keys).
 Expected<RunConfig> parse_run_config_keys(const std::string& yaml_text, const std::string& source_name,
                                           const std::string& base_dir, std::set<std::string>* keys_read) {
@@ -116,9 +130,9 @@ std::string to_yaml(const RunConfig& c) {
   YAML::Emitter e;
   e << YAML::BeginMap;
   e << YAML::Key << "mode" << YAML::Value << c.mode;
-  if (!c.gnss.rover_obs.empty()) e << YAML::Key << "rover_obs" << YAML::Value << c.gnss.rover_obs;
-  if (!c.gnss.base_obs.empty()) e << YAML::Key << "base_obs" << YAML::Value << c.gnss.base_obs;
-  if (!c.gnss.nav.empty()) e << YAML::Key << "nav" << YAML::Value << c.gnss.nav;
+  if (!c.gnss.rover_obs.empty()) e << YAML::Key << "rover_obs" << YAML::Value << absolute_path(c.gnss.rover_obs);
+  if (!c.gnss.base_obs.empty()) e << YAML::Key << "base_obs" << YAML::Value << absolute_path(c.gnss.base_obs);
+  if (!c.gnss.nav.empty()) e << YAML::Key << "nav" << YAML::Value << absolute_paths(c.gnss.nav);
   if (c.gnss.base_position_ecef_m) {
     const auto& b = *c.gnss.base_position_ecef_m;
     e << YAML::Key << "base_position_ecef_m" << YAML::Value << YAML::Flow << yaml_numbers({b.x(), b.y(), b.z()});
@@ -161,7 +175,7 @@ std::string to_yaml(const RunConfig& c) {
   }
   e << YAML::EndMap;
   if (!c.imu.file.empty()) {
-    e << YAML::Key << "imu" << YAML::Value << YAML::BeginMap << YAML::Key << "file" << YAML::Value << c.imu.file;
+    e << YAML::Key << "imu" << YAML::Value << YAML::BeginMap << YAML::Key << "file" << YAML::Value << absolute_path(c.imu.file);
     if (!c.imu.format_preset.empty()) {
       e << YAML::Key << "format" << YAML::Value << c.imu.format_preset;
     } else if (c.imu.has_format) {
@@ -178,7 +192,7 @@ std::string to_yaml(const RunConfig& c) {
   }
   if (!c.reference.file.empty()) {
     e << YAML::Key << "reference" << YAML::Value << YAML::BeginMap << YAML::Key << "file" << YAML::Value
-      << c.reference.file << YAML::Key << "format" << YAML::Value << c.reference.format;
+      << absolute_path(c.reference.file) << YAML::Key << "format" << YAML::Value << c.reference.format;
     if (!c.reference.nmea_qualities.empty()) {
       e << YAML::Key << "nmea_qualities" << YAML::Value << YAML::Flow << c.reference.nmea_qualities;
     }
@@ -217,9 +231,51 @@ std::string to_yaml(const RunConfig& c) {
       << yaml_number(i.sigma_yaw_rad * kDeg) << YAML::EndMap;
   }
   e << YAML::Key << "mechanization_rate_hz" << YAML::Value << yaml_number(c.mechanization_rate_hz);
-  e << YAML::Key << "zupt" << YAML::Value << YAML::BeginMap << YAML::Key << "detector" << YAML::Value << c.zupt.detector
-    << YAML::Key << "form" << YAML::Value << c.zupt.form << YAML::Key << "edge_s" << YAML::Value
-    << yaml_number(c.zupt.edge_s) << YAML::Key << "updates" << YAML::Value << c.zupt.updates << YAML::EndMap;
+  {
+    // Every detector and update key, so that a run of config.resolved.yaml repeats the run that wrote it (the auto
+    // threshold, its gait-adaptive raise and the ZARU noise resolved from the log included).
+    const ZuptConfig& z = c.zupt;
+    auto num = [&e](const char* key, double v) { e << YAML::Key << key << YAML::Value << yaml_number(v); };
+    auto deg = [&e](const char* key, double rad) { e << YAML::Key << key << YAML::Value << yaml_degrees(rad); };
+    e << YAML::Key << "zupt" << YAML::Value << YAML::BeginMap << YAML::Key << "detector" << YAML::Value << z.detector
+      << YAML::Key << "form" << YAML::Value << z.form;
+    num("mv_window_s", z.mv_window_s);
+    num("mv_threshold_mps2", z.mv_threshold_mps2);
+    deg("mv_gyro_threshold_deg_per_s", z.mv_gyro_threshold_radps);
+    num("min_time_since_step_s", z.min_time_since_step_s);
+    num("shoe_window_s", z.shoe_window_s);
+    num("shoe_sigma_accel_mps2", z.shoe_sigma_accel_mps2);
+    deg("shoe_sigma_gyro_deg_per_s", z.shoe_sigma_gyro_radps);
+    if (z.shoe_threshold_auto) {
+      e << YAML::Key << "shoe_threshold" << YAML::Value << "auto";
+      num("shoe_threshold_motion", z.shoe_threshold_motion);
+      num("shoe_threshold_two_class_cap", z.shoe_threshold_two_class_cap);
+    } else {
+      num("shoe_threshold", z.shoe_threshold);
+    }
+    num("shoe_adaptive_factor", z.shoe_adaptive_factor);
+    num("shoe_adaptive_window_s", z.shoe_adaptive_window_s);
+    deg("shoe_adaptive_min_peak_rate_deg_per_s", z.shoe_adaptive_min_peak_radps);
+    num("min_stance_s", z.min_stance_s);
+    num("are_threshold", z.are_threshold);
+    num("mag_threshold", z.mag_threshold);
+    e << YAML::Key << "hmm_gyro_axis" << YAML::Value << z.hmm_gyro_axis;
+    num("hmm_smooth_window_s", z.hmm_smooth_window_s);
+    deg("hmm_grade_width_deg_per_s", z.hmm_grade_width_radps);
+    if (!z.hmm_model_file.empty()) e << YAML::Key << "hmm_model" << YAML::Value << absolute_path(z.hmm_model_file);
+    e << YAML::Key << "hmm_train_on_log" << YAML::Value << z.hmm_train_on_log << YAML::Key << "hmm_auto_sign"
+      << YAML::Value << z.hmm_auto_sign << YAML::Key << "hmm_max_iterations" << YAML::Value << z.hmm_max_iterations
+      << YAML::Key << "hmm_decoder" << YAML::Value << z.hmm_decoder;
+    num("hmm_rest_s", z.hmm_rest_s);
+    num("hmm_min_swing_s", z.hmm_min_swing_s);
+    num("hmm_refine_factor", z.hmm_refine_factor);
+    num("sigma_mps", z.sigma_mps);
+    num("edge_s", z.edge_s);
+    e << YAML::Key << "updates" << YAML::Value << z.updates << YAML::Key << "zaru" << YAML::Value << z.zaru;
+    deg("zaru_sigma_deg_per_s", z.zaru_sigma_radps);
+    num("zaru_gate_probability", z.zaru_gate_probability);
+    e << YAML::EndMap;
+  }
   e << YAML::Key << "fault_rejection" << YAML::Value << YAML::BeginMap << YAML::Key << "probability" << YAML::Value
     << yaml_number(c.fault_rejection_probability) << YAML::Key << "window_epochs" << YAML::Value
     << c.fault_rejection_window_epochs << YAML::EndMap;

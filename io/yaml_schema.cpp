@@ -8,6 +8,8 @@
 #include <map>
 #include <sstream>
 
+#include "core/geodesy.hpp"
+
 namespace pednav::io {
 namespace {
 
@@ -37,6 +39,16 @@ std::string yaml_number(double v) {
   if (std::isnan(v)) return ".nan";
   if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
   return fmt::format("{}", v);  // fmt's shortest round-trip form (Dragonbox)
+}
+
+std::string yaml_degrees(double radians) {
+  if (!std::isfinite(radians)) return yaml_number(radians * kRadToDeg);
+  const double deg = radians * kRadToDeg;
+  for (int digits = 1; digits <= 17; ++digits) {
+    const std::string s = fmt::format("{:.{}g}", deg, digits);
+    if (std::stod(s) * kDegToRad == radians) return yaml_number(std::stod(s));
+  }
+  return yaml_number(deg);
 }
 
 std::vector<std::string> yaml_numbers(std::initializer_list<double> v) {

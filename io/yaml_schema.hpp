@@ -28,6 +28,9 @@ Expected<YamlSource> read_yaml_source(const std::string& path, const std::string
 /// A double as YAML text: the shortest decimal that reads back to the same double ("0.1", where yaml-cpp's emitter
 /// writes 0.10000000000000001); .inf, -.inf, .nan for the others. Emit it as a scalar: `e << yaml_number(v)`.
 std::string yaml_number(double v);
+/// A value the reader converts from degrees (`key_deg…: v` → v · π/180): the shortest decimal v that the reader turns
+/// back into the same radians (60 for 60 · π/180, not 59.99999999999999).
+std::string yaml_degrees(double radians);
 /// The same for a list (a flow sequence of numbers: `e << YAML::Flow << yaml_numbers({x, y, z})`).
 std::vector<std::string> yaml_numbers(std::initializer_list<double> v);
 

@@ -62,6 +62,26 @@ TEST(Alignment, MovingOrWrongUnitsAreRejectedWithReason) {
   EXPECT_THAT(bad.error().message, HasSubstr("is not local gravity"));
 }
 
+// A consumer accelerometer's zero-g offset (tens of mg, ~100 mg on some axes) is not a wrong unit: 1.0 m/s² along the
+// vertical levels (the old 0.5 m/s² tolerance refused it and the run started without a levelled attitude), 2.0 m/s²
+// is refused with the unit message (StillnessOptions::max_gravity_error_mps2 = 1.5).
+TEST(Alignment, AConsumerAccelerometerOffsetLevelsAndTwoMetresPerSecondSquaredDoNot) {
+  const NavState truth = test::nav_state_from_ll(GpsTime(), 45.0, 7.0, 0.0, 0.0, 0.0, 0.0);
+  for (const double offset_mps2 : {1.0, 2.0}) {
+    auto log = still_log(truth, Eigen::Vector3d::Zero(), 200, 9);
+    for (auto& x : log) x.f_ib_b.z() -= offset_mps2;  // body z down: f_z = -g - offset
+    auto lv = coarse_level(log, truth.p_eb_e);
+    if (offset_mps2 < StillnessOptions{}.max_gravity_error_mps2) {
+      ASSERT_TRUE(lv) << lv.error().message;
+      EXPECT_NEAR(lv->roll, 0.0, kTolAngle_rad);
+      EXPECT_NEAR(lv->pitch, 0.0, kTolAngle_rad);
+    } else {
+      ASSERT_FALSE(lv);
+      EXPECT_THAT(lv.error().message, HasSubstr("is not local gravity"));
+    }
+  }
+}
+
 // Eq. 6.1 of docs/ins.md: d² of a still window's bias estimate against the turn-on prior; a window that rolls at
 // 1 deg/s for its last second is far outside a 0.04 deg/s prior, a static one with a 1-sigma bias is not.
 TEST(Alignment, StillWindowGyroBiasIsCheckedAgainstTheTurnOnPrior) {

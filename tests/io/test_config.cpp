@@ -2,6 +2,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cctype>
+#include <stdexcept>
+
 #include "core/geodesy.hpp"
 #include "io/config.hpp"
 #include "io/yaml_schema.hpp"
@@ -469,7 +472,27 @@ TEST(Config, ResolvedNumbersAreTheShortestThatReadBack) {
   EXPECT_THAT(y, HasSubstr("edge_s: 0.07\n")) << y;
   EXPECT_THAT(y, HasSubstr("lever_arm_ned_m: [0.1, -0.2, -1.3]")) << y;
   EXPECT_THAT(y, HasSubstr("base_position_ecef_m: [3774085.6456, -601662.5769, 5089316.397]")) << y;
-  EXPECT_THAT(y, ::testing::Not(::testing::ContainsRegex("[0-9]{15}"))) << "a 17-digit form is left:\n" << y;
+  // Every number is the shortest decimal of its double (keys in degrees: the shortest the reader turns back into
+  // the same radians, yaml_degrees), so no 17-digit form is left.
+  for (size_t b = 0; b < y.size();) {
+    const size_t e = y.find_first_of(" ,[]\n", b);
+    const std::string tok = y.substr(b, e == std::string::npos ? std::string::npos : e - b);
+    b = e == std::string::npos ? y.size() : e + 1;
+    if (tok.empty() || !(std::isdigit(static_cast<unsigned char>(tok[0])) || tok[0] == '-')) continue;
+    size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(tok, &used);
+    } catch (const std::exception&) {
+      continue;
+    }
+    if (used != tok.size()) continue;
+    EXPECT_EQ(tok, yaml_number(v)) << "not the shortest form:\n" << y;
+  }
+  EXPECT_THAT(y, HasSubstr("hmm_grade_width_deg_per_s: 60\n")) << y;
+  EXPECT_EQ(yaml_degrees(60.0 * kDegToRad), "60");
+  EXPECT_EQ(yaml_degrees(60.0 * 3.14159265358979323846 / 180.0), "60");
+  EXPECT_EQ(std::stod(yaml_degrees(1.5)) * kDegToRad, 1.5);
   // Shortest, yet exact: every value reads back bit for bit.
   auto again = parse(y);
   ASSERT_TRUE(again) << again.error().message;
