@@ -19,6 +19,7 @@
 #include "core/row_transition.hpp"
 #include "core/geodesy.hpp"
 #include "fusion/engine.hpp"
+#include "fusion/stance_updates.hpp"
 #include "fusion/kalman.hpp"
 #include "fusion/rts.hpp"
 #include "gnss/least_squares.hpp"

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "core/time.hpp"
-#include "fusion/engine.hpp"
+#include "fusion/engine_types.hpp"
 #include "fusion/error_state_filter.hpp"
 #include "fusion/lever_arm.hpp"
 #include "gnss/base_phase.hpp"

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "core/row_transition.hpp"
-#include "fusion/engine.hpp"
+#include "fusion/engine_types.hpp"
 #include "fusion/kalman.hpp"
 #include "fusion/rts.hpp"
 #include "gnss/types.hpp"

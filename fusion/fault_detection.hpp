@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "core/time.hpp"
-#include "fusion/engine.hpp"
+#include "fusion/engine_types.hpp"
 #include "gnss/types.hpp"
 #include "ins/error_state.hpp"
 

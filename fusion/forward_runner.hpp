@@ -14,7 +14,7 @@
 
 #include "core/expected.hpp"
 #include "core/time.hpp"
-#include "fusion/engine.hpp"
+#include "fusion/engine_types.hpp"
 #include "fusion/error_state_filter.hpp"
 #include "fusion/gnss_update.hpp"
 #include "fusion/stance_updates.hpp"

@@ -13,7 +13,7 @@
 
 #include "core/time.hpp"
 #include "fusion/carrier_update.hpp"
-#include "fusion/engine.hpp"
+#include "fusion/engine_types.hpp"
 #include "fusion/error_state_filter.hpp"
 #include "fusion/fault_detection.hpp"
 #include "fusion/stride_velocity.hpp"

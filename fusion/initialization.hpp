@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "core/expected.hpp"
-#include "fusion/engine.hpp"
+#include "fusion/engine_types.hpp"
 #include "fusion/gnss_update.hpp"
 #include "ins/alignment.hpp"
 #include "ins/imu.hpp"

@@ -7,13 +7,17 @@
 
 #include <Eigen/Core>
 
-#include "fusion/engine.hpp"
+#include "fusion/engine_types.hpp"
 #include "fusion/error_state_filter.hpp"
 #include "fusion/step_velocity.hpp"
 #include "ins/error_state.hpp"
 #include "ins/imu.hpp"
 
 namespace pednav::fusion {
+
+/// The ZUPT measurement Jacobian w.r.t. the error state (velocity and attitude blocks) for the estimated
+/// velocity v_e [m/s]: form F: [I 0], form D: [I [v×]] (docs/fusion.md eq. 4.3; seed 001 eq. 8-9).
+Eigen::Matrix<double, 3, 6> zupt_jacobian(const Eigen::Vector3d& v_e, ZuptForm form);
 
 class StanceUpdater {
  public:

@@ -468,7 +468,8 @@ Expected<RunOutputs> compute_run(const RunConfig& c, const RunInputs& data, std:
                  {"events", sum.health_events}};
   for (const auto& e : sum.health_events) spdlog::warn("{}", e);
   // Does the log fit the model? (docs/fusion.md §15): each warning with its figure and what to try.
-  const std::vector<RunWarning> warnings = run_warnings(*res, opt.spec);
+  std::vector<RunWarning> warnings = imu_log_warnings(imu->samples);
+  for (auto& w : run_warnings(*res, opt.spec)) warnings.push_back(std::move(w));
   j["warnings"] = run_warnings_json(warnings);
   for (const auto& w : warnings) spdlog::warn("{}: {}; {}", c.imu.file, w.message, w.hint);
   j["accounting"] = accounting_json(*imu, data, sum, opt.mode == fusion::Mode::kTightlyCoupled);

@@ -14,6 +14,7 @@ namespace pednav::pipeline {
 namespace {
 
 constexpr double kChi2Dof2P99 = 9.2103;  // χ²(2) 99 % quantile: −2 ln 0.01
+constexpr double kStandardGravity = 9.80665;  // [m/s²]
 
 double median(std::vector<double> v) {
   if (v.empty()) return std::nan("");
@@ -161,6 +162,51 @@ std::vector<RunWarning> run_warnings(const fusion::EngineResult& result, const i
   check_disagreement(result, limits, out);
   check_gait(result, limits, out);
   check_gyro_bias(result, spec, limits, out);
+  return out;
+}
+
+std::vector<RunWarning> imu_log_warnings(const std::vector<ins::ImuSample>& samples, const RunWarningLimits& l) {
+  std::vector<RunWarning> out;
+  if (samples.size() < 10) return out;
+  std::vector<double> w, f, dt;
+  w.reserve(samples.size());
+  f.reserve(samples.size());
+  dt.reserve(samples.size());
+  for (size_t i = 0; i < samples.size(); ++i) {
+    w.push_back(samples[i].omega_ib_b.norm());
+    f.push_back(std::abs(samples[i].f_ib_b.norm() - kStandardGravity));
+    if (i > 0) dt.push_back(samples[i].t - samples[i - 1].t);
+  }
+  auto quantile = [](std::vector<double> v, double q) {
+    const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())));
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+    return v[k];
+  };
+  const double w999 = quantile(w, 0.999), f99 = quantile(f, 0.99);
+  if (w999 > l.gyro_max_plausible_radps) {
+    out.push_back({"gyro_unit",
+                   fmt::format("gyro rates reach {:.0f} rad/s (99.9th percentile; a foot's swing peaks at 5-15 rad/s, "
+                               "limit {:.0f})", w999, l.gyro_max_plausible_radps),
+                   w999, l.gyro_max_plausible_radps,
+                   "data in deg/s declared rad_per_s? Check imu.format.gyro.unit (and the columns)"});
+  } else if (w999 < l.gyro_min_walking_radps && f99 > l.accel_step_mps2) {
+    out.push_back({"gyro_unit",
+                   fmt::format("the accelerometer shows steps (| |f| - g | to {:.1f} m/s^2) but the gyro never exceeds "
+                               "{:.3f} rad/s (limit {:.1f})", f99, w999, l.gyro_min_walking_radps),
+                   w999, l.gyro_min_walking_radps,
+                   "data in rad/s declared deg_per_s? Check imu.format.gyro.unit (and the columns)"});
+  }
+  const double dt_median = median(dt);
+  if (dt_median > 0.0) {
+    const double rate = 1.0 / dt_median;
+    if (rate < l.rate_min_hz || rate > l.rate_max_hz) {
+      out.push_back({"imu_rate",
+                     fmt::format("{:.4g} Hz from the time column (limits {:.0f}-{:.0f} Hz)", rate, l.rate_min_hz,
+                                 l.rate_max_hz),
+                     rate, rate < l.rate_min_hz ? l.rate_min_hz : l.rate_max_hz,
+                     "a wrong time unit? Check imu.format.time (unit s, ms, us, ns; base)"});
+    }
+  }
   return out;
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fusion/engine.hpp"
+#include "ins/imu.hpp"
 #include "ins/imu_spec.hpp"
 
 namespace pednav::pipeline {
@@ -36,12 +37,26 @@ struct RunWarningLimits {
   double cadence_max_hz = 2.0;
   double max_stride_s = 3.0;             ///< longer stance-to-stance gaps are pauses, not strides
   double gyro_bias_sigmas = 3.0;         ///< final gyro bias estimate beyond this many of the spec's bias σ
+  /// IMU log checks (imu_log_warnings): the 99.9th percentile of |ω| above this is no foot's (swing peaks 5–15 rad/s;
+  /// 40 rad/s = 2300 °/s, beyond most MEMS ranges): a unit declared rad/s for data in °/s.
+  double gyro_max_plausible_radps = 40.0;
+  /// ... below this while the accelerometer shows steps (its 99th percentile of | |f| − g | above accel_step_mps2):
+  /// a foot that steps without turning its sole, i.e. data in rad/s declared °/s.
+  double gyro_min_walking_radps = 0.3;
+  double accel_step_mps2 = 3.0;
+  double rate_min_hz = 20.0;             ///< sample rate from the time column outside this band: a wrong time unit
+  double rate_max_hz = 10000.0;
 };
 
 /// The checks on the result of one run with the filter's IMU spec (after self-calibration). An empty list: the log
 /// fits.
 std::vector<RunWarning> run_warnings(const fusion::EngineResult& result, const ins::ImuSpec& spec,
                                      const RunWarningLimits& limits = {});
+
+/// Checks of the IMU log itself against what its configuration declares (issue 49 item 3): gyro rates no foot
+/// produces (`gyro_unit`: a unit declared rad/s for °/s data, or the reverse), a sample rate from the time column
+/// outside 20 Hz – 10 kHz (`imu_rate`: the time unit). Samples in the engine's units (rad/s, m/s², GPST).
+std::vector<RunWarning> imu_log_warnings(const std::vector<ins::ImuSample>& samples, const RunWarningLimits& limits = {});
 
 /// summary.json `warnings`: a JSON array (one object per warning: code, message, value, limit, hint).
 nlohmann::ordered_json run_warnings_json(const std::vector<RunWarning>& warnings);

@@ -349,7 +349,13 @@ void BodyTrack::antenna_n0(double t_s, Eigen::Vector3d& p, Eigen::Vector3d& v, d
 WalkTruth synthesize_walk(const Scenario& sc, const LocalFrame& frame, const StridePlan& plan) {
   WalkTruth out;
   const double rate = sc.imu.rate_hz;
+  // Sample k at k periods after the start, to the nanosecond: exact for rates whose period is a whole number of
+  // nanoseconds, rounded (±0.5 ns) for the others (60 Hz); the truth is the mechanization of these very samples.
   const int64_t period_ns = std::llround(1e9 / rate);
+  const bool whole_ns_period = std::abs(1e9 / rate - static_cast<double>(period_ns)) <= 1e-6;
+  auto sample_offset_ns = [&](long k) -> int64_t {
+    return whole_ns_period ? k * period_ns : std::llround(static_cast<long double>(k) * 1e9L / rate);
+  };
   const long n = std::lround(plan.duration_s * rate) + 1;
   out.imu.reserve(static_cast<size_t>(n));
   out.nav.reserve(static_cast<size_t>(n));
@@ -379,7 +385,7 @@ WalkTruth synthesize_walk(const Scenario& sc, const LocalFrame& frame, const Str
   Eigen::Vector3d pA = Eigen::Vector3d::Zero(), eulerA = Eigen::Vector3d::Zero();
   long anchored = -1;
   for (long k = 0; k < n; ++k) {
-    const GpsTime t = sc.start.plus_ns(k * period_ns);
+    const GpsTime t = sc.start.plus_ns(sample_offset_ns(k));
     const double ts = static_cast<double>(k) / rate;
     while (si < plan.strides.size() && k > std::lround((plan.strides[si].t_lift_s + plan.strides[si].swing_s) * rate)) ++si;
     ins::ImuSample m;

@@ -21,6 +21,7 @@
 
 #include "core/geodesy.hpp"
 #include "fusion/engine.hpp"
+#include "fusion/stance_updates.hpp"
 #include "ins/alignment.hpp"
 #include "ins/error_state.hpp"
 #include "ins/gravity.hpp"

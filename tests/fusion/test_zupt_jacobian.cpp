@@ -8,6 +8,7 @@
 
 #include "core/rotation.hpp"
 #include "fusion/engine.hpp"
+#include "fusion/stance_updates.hpp"
 #include "ins/error_state.hpp"
 #include "tests/support/numdiff.hpp"
 

@@ -188,3 +188,80 @@ TEST(UnknownSensor, AnAccelerometerOffOneGAtRestStillCalibratesAndClosesTheLoop)
 
 }  // namespace
 }  // namespace pednav
+
+namespace pednav {
+namespace {
+
+struct MinimalRun {
+  eval::Evaluation ev;
+  std::string warnings;
+};
+
+// `pednav simulate` of a scenario, then the minimal configuration (no imu.spec, no zupt.shoe_threshold: both from the
+// log) and `pednav compare --loop` of the forward solution against the truth.
+MinimalRun run_minimal(const std::string& scenario, const std::string& name) {
+  MinimalRun out;
+  auto file = io::load_scenario(test::source_path(scenario));
+  EXPECT_TRUE(file) << file.error().message;
+  if (!file) return out;
+  const std::string dir = test::temp_dir(name);
+  EXPECT_TRUE(pipeline::run_simulate_command(*file, dir).has_value());
+  {  // the written configuration without its `spec:` line, as a user with this sensor would start
+    std::ifstream in(dir + "/config.yaml");
+    std::ofstream minimal(dir + "/minimal.yaml");
+    for (std::string line; std::getline(in, line);) {
+      if (line.find("  spec:") != 0) minimal << line << "\n";
+    }
+  }
+  auto cfg = io::load_run_config(dir + "/minimal.yaml");
+  EXPECT_TRUE(cfg) << cfg.error().message;
+  if (!cfg) return out;
+  EXPECT_TRUE(cfg->imu.spec_auto && cfg->zupt.shoe_threshold_auto);
+  auto sum = pipeline::run_run_command(*cfg, dir + "/run");
+  EXPECT_TRUE(sum) << sum.error().message;
+  pipeline::CompareArgs args;
+  args.solution = dir + "/run/solution.csv";
+  args.reference = dir + "/truth.csv";
+  args.out_dir = dir + "/cmp";
+  args.compare.loop = true;
+  args.plots = false;
+  auto ev = pipeline::run_compare(args);
+  EXPECT_TRUE(ev) << ev.error().message;
+  if (ev) out.ev = *ev;
+  std::ifstream js(dir + "/run/summary.json");
+  const auto summary = nlohmann::json::parse(js);
+  for (const auto& w : summary["warnings"]) out.warnings += w["code"].get<std::string>() + " ";
+  return out;
+}
+
+// Issue 49's second unknown sensor: 60 Hz (sample times rounded to the nanosecond), z down, 3x the Crista's noise,
+// 0.5 °/s turn-on bias σ (datasets/unknown_sensor_60hz.yaml, seed 6060). Measured 2026-12-06: closure 0.47 % of
+// 188 m, RMS 1.31 m (start as configured). Over seeds 1-8 as well (scripts/unknown_sensors): median 1.13 %, worst
+// 4.29 %, <= 1 % on 4 of 9 — the issue's 1 % holds on this seed, not on every draw (docs/results.md). Bounds: the
+// measured figures + 30 %.
+TEST(UnknownSensor, SixtyHertzZDownClosesTheLoopWithTheMinimalConfiguration) {
+  const MinimalRun r = run_minimal("datasets/unknown_sensor_60hz.yaml", "unknown_sensor_60hz");
+  std::printf("[unknown sensor 60 Hz] closure %.2f %% of %.1f m, RMS %.3f m; warnings: %s\n",
+              r.ev.closure_pct_of_distance, r.ev.distance_m, r.ev.horizontal_rms_m,
+              r.warnings.empty() ? "none" : r.warnings.c_str());
+  EXPECT_LT(r.ev.closure_pct_of_distance, 0.47 * 1.3);
+  EXPECT_LT(r.ev.horizontal_rms_m, 1.31 * 1.3);
+  EXPECT_EQ(r.warnings, "");
+  EXPECT_NEAR(r.ev.distance_m, 189.0, 0.01 * 189.0);  // this draw's strides
+}
+
+// The third: 1000 Hz, turned 90° in yaw on the foot, 1 °/s turn-on bias σ (datasets/unknown_sensor_1000hz.yaml, seed
+// 1000). The configuration's start yaw is the foot's, so only the closure is scored. Measured 2026-12-06: 2.76 % of
+// 188 m — the issue's 1 % is NOT met on this draw (seeds 1-8: median 1.07 %, worst 2.76 %, <= 1 % on 3 of 9); the run
+// warns forward_smoothed_disagree (6.0 % of the epochs beyond 99 %). Bound: the measured closure + 30 %.
+TEST(UnknownSensor, ThousandHertzTurnedNinetyDegreesClosesTheLoopWithTheMinimalConfiguration) {
+  const MinimalRun r = run_minimal("datasets/unknown_sensor_1000hz.yaml", "unknown_sensor_1000hz");
+  std::printf("[unknown sensor 1000 Hz] closure %.2f %% of %.1f m; warnings: %s\n", r.ev.closure_pct_of_distance,
+              r.ev.distance_m, r.warnings.empty() ? "none" : r.warnings.c_str());
+  EXPECT_EQ(r.warnings, "forward_smoothed_disagree ");  // the misfit is reported
+  EXPECT_LT(r.ev.closure_pct_of_distance, 2.76 * 1.3);
+  EXPECT_NEAR(r.ev.distance_m, 193.2, 0.01 * 193.2);  // this draw's strides
+}
+
+}  // namespace
+}  // namespace pednav

@@ -125,3 +125,56 @@ TEST(RunWarnings, GyroBiasBeyondTheSpec) {
 
 }  // namespace
 }  // namespace pednav::pipeline
+
+namespace pednav::pipeline {
+namespace {
+
+// A foot IMU log in the engine's units: 200 Hz, at rest for 2 s, then 20 strides of 1.1 s whose swing turns the sole
+// at up to 8 rad/s about y and accelerates it by up to 12 m/s² (| |f| − g | to 5.7 m/s²).
+std::vector<ins::ImuSample> foot_log(double gyro_scale = 1.0, double time_scale = 1.0) {
+  std::vector<ins::ImuSample> s;
+  const double rate = 200.0;
+  for (int k = 0; k < static_cast<int>(rate * 24.0); ++k) {
+    const double t = k / rate, tw = t - 2.0;
+    const double phase = tw >= 0.0 ? std::fmod(tw, 1.1) : 1.1;
+    const double x = phase < 0.75 ? std::sin(kPi * phase / 0.75) : 0.0;
+    ins::ImuSample m;
+    m.t = GpsTime::from_ns(2300LL * kNsPerWeek + std::llround(t * time_scale * 1e9));
+    m.omega_ib_b = gyro_scale * Eigen::Vector3d(0.01, 8.0 * x + 0.01, -0.01);
+    m.f_ib_b = Eigen::Vector3d(12.0 * x, 0.0, -9.80665);
+    s.push_back(m);
+  }
+  return s;
+}
+
+TEST(RunWarnings, AFootLogInItsDeclaredUnitsHasNoUnitWarning) {
+  EXPECT_TRUE(imu_log_warnings(foot_log()).empty());
+}
+
+// °/s read as rad/s: the swing peaks at 458 "rad/s"; rad/s read as °/s: 0.14 rad/s while the accelerometer steps.
+TEST(RunWarnings, GyroRatesNoFootProducesNameTheUnit) {
+  const auto high = imu_log_warnings(foot_log(kRadToDeg));
+  ASSERT_EQ(codes(high), std::vector<std::string>{"gyro_unit"});
+  EXPECT_THAT(high[0].message, HasSubstr("gyro rates reach 45"));
+  EXPECT_THAT(high[0].hint, HasSubstr("deg/s declared rad_per_s"));
+  EXPECT_NEAR(high[0].value, 8.0 * kRadToDeg, 1.0);
+  const auto low = imu_log_warnings(foot_log(kDegToRad));
+  ASSERT_EQ(codes(low), std::vector<std::string>{"gyro_unit"});
+  EXPECT_THAT(low[0].message, HasSubstr("the accelerometer shows steps"));
+  EXPECT_THAT(low[0].hint, HasSubstr("rad/s declared deg_per_s"));
+  EXPECT_NEAR(low[0].value, 8.0 * kDegToRad, 0.01);
+}
+
+// A time column in ms read as s: 0.2 Hz; in µs read as ms: 200 kHz.
+TEST(RunWarnings, ASampleRateFromTheWrongTimeUnitIsNamed) {
+  const auto slow = imu_log_warnings(foot_log(1.0, 1000.0));
+  ASSERT_EQ(codes(slow), std::vector<std::string>{"imu_rate"});
+  EXPECT_THAT(slow[0].message, HasSubstr("0.2 Hz from the time column"));
+  EXPECT_NEAR(slow[0].value, 0.2, 1e-6);
+  const auto fast = imu_log_warnings(foot_log(1.0, 1e-3));
+  ASSERT_EQ(codes(fast), std::vector<std::string>{"imu_rate"});
+  EXPECT_NEAR(fast[0].value, 2e5, 1.0);
+}
+
+}  // namespace
+}  // namespace pednav::pipeline
