@@ -66,7 +66,11 @@ std::string gnuplot_script(const PlotSpec& spec, const std::string& svg_path) {
   if (!spec.x_label.empty()) g += "set xlabel " + quoted(spec.x_label) + "\n";
   if (!spec.y_label.empty()) g += "set ylabel " + quoted(spec.y_label) + "\n";
   if (spec.equal_axes) g += "set size ratio -1\n";
-  if (spec.y_from_zero) g += "set yrange [0:*]\n";
+  if (std::isfinite(spec.y_min) && std::isfinite(spec.y_max)) {
+    g += fmt::format("set yrange [{}:{}]\n", spec.y_min, spec.y_max);
+  } else if (spec.y_from_zero) {
+    g += "set yrange [0:*]\n";
+  }
   for (size_t i = 0; i < spec.series.size(); ++i) g += data_block(spec.series[i], i);
   std::string plot;
   for (size_t i = 0; i < spec.series.size(); ++i) {

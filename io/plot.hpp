@@ -4,6 +4,7 @@
 // and render_svg() runs gnuplot on it. Nothing here draws by hand.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,7 @@ struct PlotSpec {
   std::vector<PlotSeries> series;
   bool equal_axes = false;         ///< same scale on x and y (maps in metres)
   bool y_from_zero = false;        ///< y axis starts at 0
+  double y_min = NAN, y_max = NAN;  ///< fixed y range when both are finite (overrides y_from_zero)
   int width_px = 820, height_px = 460;
 };
 

@@ -179,6 +179,8 @@ Expected<ReportResult> run_report_command(const std::string& run_dir) {
       topics.section("Zero-velocity updates");
       topics.plot(zupt_plot(t, zupt, 30.0), "ZUPT flag at each output epoch and its 30 s moving fraction (" + f.name + ").");
     }
+    // With carrier phase: the status of the first solution's epochs (pednav run: solution.csv; pednav gnss: gnss.csv).
+    carrier_status_section(topics, dir / (fs::exists(dir / "solution.csv") ? "solution.csv" : "gnss.csv"), t0, p0);
   }
   for (const auto& d : outage_dirs) outage_section(sols.empty() ? h : topics, d, dir);
 

@@ -111,6 +111,10 @@ void evaluation_section(Html& h, const fs::path& dir);
 std::string health_html(const nlohmann::json& j, const std::vector<std::string>& warnings);
 /// Every key of summary.json, flattened to dotted names, values rounded; collapsed at the end of the page.
 std::string appendix_html(const nlohmann::json& j);
+/// The carrier-phase status section (io/report_carrier.cpp) when `csv` (solution.csv or gnss.csv) has a
+/// solution_status column:
+/// status over time and along the track (East/North about p0_e), shares, time to first fix. False: no section.
+bool carrier_status_section(Html& h, const fs::path& csv, GpsTime t0, const Eigen::Vector3d& p0_e);
 /// An outage study found in d (the run folder or one of its subfolders).
 void outage_section(Html& h, const fs::path& d, const fs::path& run_dir);
 

@@ -36,6 +36,15 @@ TEST(Plot, ScriptHasDataBlocksStylesAndBreaksAtNaN) {
   EXPECT_THAT(g, HasSubstr("with lines lw 1.5 lc rgb '#123456' title 'line'"));
   EXPECT_THAT(g, HasSubstr("using 1:2:3 with filledcurves"));
   EXPECT_THAT(g, Not(HasSubstr("nan")));
+  EXPECT_THAT(g, Not(HasSubstr("set yrange")));
+  PlotSpec fixed = two_series();
+  fixed.y_from_zero = true;
+  EXPECT_THAT(gnuplot_script(fixed, "/tmp/x.svg"), HasSubstr("set yrange [0:*]\n"));
+  fixed.y_min = -0.5;
+  fixed.y_max = 3.5;  // a fixed range wins over y_from_zero
+  const std::string gf = gnuplot_script(fixed, "/tmp/x.svg");
+  EXPECT_THAT(gf, HasSubstr("set yrange [-0.5:3.5]\n"));
+  EXPECT_THAT(gf, Not(HasSubstr("set yrange [0:*]")));
 }
 
 TEST(Plot, GnuplotRendersSvg) {

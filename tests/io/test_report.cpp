@@ -4,6 +4,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -125,6 +126,37 @@ TEST(Report, RunFolderGivesSelfContainedHtmlWithEveryPlot) {
   EXPECT_THAT(html, HasSubstr("<tr><td>1</td><td>225100.0</td><td>3.0</td><td>1.20</td>"));
   EXPECT_THAT(html, Not(HasSubstr("src=\"http")));  // nothing fetched from the network
   EXPECT_THAT(html, Not(HasSubstr("src=\"file")));
+}
+
+// With carrier phase (issue 48 item 7): solution.csv's solution_status over time and along the track, the share of
+// each status and the time to the first fix; runs without the column (the test above) have no such section.
+TEST(Report, CarrierStatusOverTimeAndAlongTheTrack) {
+  const std::string d = test::temp_dir("report_carrier");
+  test::write_report_fixture(d);
+  {
+    std::ifstream in(d + "/solution.csv");
+    std::string out, line;
+    std::getline(in, line);
+    out += line + ",solution_status,n_fixed_ambiguities,ar_ratio\n";
+    for (int i = 0; std::getline(in, line); ++i) {
+      // 50 code, 10 float, 140 fixed (6 ambiguities), 20 ins, 80 float epochs
+      const char* st = i < 50 ? "code" : i < 60 ? "float" : i < 200 ? "fixed" : i < 220 ? "ins" : "float";
+      out += line + fmt::format(",{},{},{:.2f}\n", st, i >= 60 && i < 200 ? 6 : 0, i >= 60 && i < 200 ? 4.5 : 0.0);
+    }
+    std::ofstream(d + "/solution.csv") << out;
+  }
+  auto r = run_report_command(d);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  for (const auto& w : r->warnings) ADD_FAILURE() << "warning: " << w;
+  EXPECT_EQ(r->plots, test::kReportFixturePlots + 3);  // status over time, track by status, fixed ambiguities
+  EXPECT_NE(std::find(r->sections.begin(), r->sections.end(), "Carrier-phase solution status"), r->sections.end());
+  const std::string html = test::read_text(d + "/report.html");
+  EXPECT_THAT(html, HasSubstr("300 epochs of solution.csv carry a status"));
+  EXPECT_THAT(html, HasSubstr("<tr><td>fixed</td><td>140</td><td>46.7 %</td><td>60.0</td></tr>"));
+  EXPECT_THAT(html, HasSubstr("<tr><td>float</td><td>90</td><td>30.0 %</td><td>50.0</td></tr>"));
+  EXPECT_THAT(html, HasSubstr("<tr><td>code</td><td>50</td><td>16.7 %</td><td>0.0</td></tr>"));
+  EXPECT_THAT(html, HasSubstr("<tr><td>ins</td><td>20</td><td>6.7 %</td><td>200.0</td></tr>"));
+  EXPECT_THAT(html, HasSubstr("alt=\"Track by solution status\""));
 }
 
 }  // namespace
