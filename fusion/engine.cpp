@@ -22,6 +22,37 @@ namespace pednav::fusion {
 
 using Eigen::Vector3d;
 
+namespace {
+
+// A foot's swing turns it faster than this (foot: 3-15 rad/s; ins::CalibrationOptions::swing_rate_radps) for about a
+// third of every stride; an IMU above it on fewer than kNotOnFootMaxSwingShare of the samples after its levelling
+// window (a hand turning with the walker at a corner), on a GNSS track that moves at least kNotOnFootMinTrackM, is
+// not on a foot.
+constexpr double kFootSwingRateRadps = 2.0;
+constexpr double kNotOnFootMaxSwingShare = 0.005;
+constexpr double kNotOnFootMinTrackM = 20.0;
+
+// Largest horizontal distance of the GNSS epoch solutions (every 10th epoch from t_start) from the first one [m];
+// 0 without GNSS.
+double gnss_track_extent(const EngineInputs& in, const EngineOptions& o, GpsTime t_start) {
+  if (!in.rover || !in.nav) return 0.0;
+  const GnssEpochUpdater gnss(in, o);
+  std::optional<Vector3d> first;
+  Vector3d prev = o.base_position_e.value_or(Vector3d::Zero());
+  double extent = 0.0;
+  for (size_t g = 0; g < in.rover->size(); g += 10) {
+    if ((*in.rover)[g].time < t_start) continue;
+    const auto pa = gnss.lsq_position(g, prev);
+    if (!pa) continue;
+    prev = *pa;
+    if (!first) first = *pa;
+    extent = std::max(extent, enu_from_ecef(*pa, *first).head<2>().norm());
+  }
+  return extent;
+}
+
+}  // namespace
+
 std::vector<std::string> EngineOptions::problems() const {
   std::vector<std::string> p = zupt.problems();
   if (!(mechanization_rate_hz > 0)) p.push_back("mechanization_rate_hz must be > 0");
@@ -56,12 +87,34 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
     if (in.base && !o.base_position_e) return make_error("base observations given without a base position");
   }
   if (auto p = ins::stance_label_problem(o.zupt, in.stance_labels, samples.size()); !p.empty()) return make_error(p);
-  const std::vector<ins::ZuptDecision> decisions = ins::detect_stance(samples, o.zupt, in.stance_labels);
+  std::vector<ins::ZuptDecision> decisions = ins::detect_stance(samples, o.zupt, in.stance_labels);
 
   // Start at the first still period (levelling window): the first stance run of >= kMinLevellingWindowS.
   const auto still_period = first_still_period(samples, decisions);
   if (!still_period) return make_error("IMU: no still period found to level the IMU (the ZUPT detector never fired)");
   const auto [s0, s1] = *still_period;
+  EngineOptions opt = o;
+  std::string not_on_foot;
+  if (tc) {
+    // An IMU that is not on a foot (docs/fusion.md §8.2): no swing while the GNSS track moves. A hand moving at a
+    // steady speed looks still to every stance detector, so its "stances" would be false ZUPTs: none after the
+    // levelling window, and the Doppler rows see the IMU's own velocity.
+    size_t swings = 0;
+    for (size_t i = s1; i < samples.size(); ++i) swings += samples[i].omega_ib_b.norm() > kFootSwingRateRadps;
+    if (static_cast<double>(swings) < kNotOnFootMaxSwingShare * static_cast<double>(samples.size() - s1)) {
+      const double moved_m = gnss_track_extent(in, o, samples[s0].t);
+      if (moved_m >= kNotOnFootMinTrackM) {
+        for (size_t i = s1; i < decisions.size(); ++i) decisions[i].stance = false;
+        opt.antenna_velocity_model = AntennaVelocityModel::kFoot;
+        not_on_foot = fmt::format("; rates above {:.0f} rad/s on {:.2f} % of the samples (a foot: about a third) while "
+                                  "the GNSS track moves {:.0f} m: an IMU not on a foot (hand-held, pocket, body-worn), "
+                                  "no ZUPT after the levelling window",
+                                  kFootSwingRateRadps,
+                                  100.0 * static_cast<double>(swings) / static_cast<double>(samples.size() - s1),
+                                  moved_m);
+      }
+    }
+  }
   const std::vector<ins::ImuSample> still(samples.begin() + static_cast<long>(s0), samples.begin() + static_cast<long>(s1));
 
   EngineResult result;
@@ -96,9 +149,9 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
   if (!level) return make_error("IMU levelling at " + samples[s0].t.to_string() + ": " + level.error().message);
   const ins::ImuErrors imu0 = initial_imu_errors(*level, o.spec, sum, how);
 
+  how += not_on_foot;
   // Heading: configured, else from motion (INS/ZUPT track with yaw 0 fitted to the GNSS epoch solutions).
   double yaw0 = 0.0;
-  EngineOptions opt = o;
   if (o.heading_from_magnetometer) {
     if (!in.mag_b || in.mag_b->size() != samples.size()) {
       return make_error("heading from the magnetometer needs one magnetometer vector per IMU sample (got " +

@@ -86,12 +86,107 @@ ins::ImuErrors initial_imu_errors(const ins::Levelling& level, const ins::ImuSpe
   return imu0;
 }
 
+namespace {
+
+// An IMU that shows no stance once the walker moves (hand-held, pocket, body-worn; docs/fusion.md §8.2): the share of
+// stance samples over the first kNoStanceWindowS after the levelling window's stance ends is below kNoStanceShare.
+constexpr double kNoStanceWindowS = 20.0;
+constexpr double kNoStanceShare = 0.05;
+
+// First sample after `start` that is not stance (the walker leaves the levelling window), or samples.size().
+size_t first_motion_sample(const std::vector<ins::ZuptDecision>& decisions, size_t start) {
+  size_t i = start;
+  while (i < decisions.size() && decisions[i].stance) ++i;
+  return i;
+}
+
+bool shows_no_stance(const std::vector<ins::ImuSample>& samples, const std::vector<ins::ZuptDecision>& decisions,
+                     size_t moving) {
+  size_t n = 0, stance = 0;
+  for (size_t i = moving; i < samples.size() && samples[i].t - samples[moving].t <= kNoStanceWindowS; ++i) {
+    ++n;
+    stance += decisions[i].stance;
+  }
+  return n > 0 && samples.back().t - samples[moving].t >= kNoStanceWindowS &&
+         static_cast<double>(stance) < kNoStanceShare * static_cast<double>(n);
+}
+
+// Heading from the GNSS course (docs/fusion.md eq. 8.3): the device faces along the walk, so its yaw at the start is
+// the direction from the mean GNSS epoch solution while the walker stood to the first solutions at least D (the
+// heading-from-motion distance) further, with σ from the solutions' scatter about that chord.
+Expected<HeadingFromMotion> heading_from_gnss_course(const EngineInputs& in, const EngineOptions& o,
+                                                     const GnssEpochUpdater& gnss, size_t start, size_t moving,
+                                                     const ins::NavState& nav0, EngineSummary& sum, std::string& how) {
+  const auto& samples = *in.imu;
+  const GpsTime t_start = samples[start].t, t_move = samples[moving].t;
+  Vector3d prev = nav0.p_eb_e, still_sum = Vector3d::Zero();
+  int n_still = 0;
+  std::vector<std::pair<GpsTime, Vector3d>> walk;  // solutions after the walker started moving, in time order
+  std::optional<Vector3d> origin;
+  for (size_t g = 0; g < in.rover->size(); ++g) {
+    const GpsTime t = (*in.rover)[g].time;
+    if (t < t_start) continue;
+    auto pa = gnss.lsq_position(g, prev);
+    if (!pa) continue;
+    prev = *pa;
+    if (t < t_move) {
+      still_sum += *pa;
+      ++n_still;
+      continue;
+    }
+    if (!origin) origin = n_still > 0 ? Vector3d(still_sum / n_still) : *pa;
+    walk.push_back({t, *pa});
+    const Vector3d d = enu_from_ecef(*pa, *origin);
+    if (d.head<2>().norm() >= o.heading_init_distance_m && walk.size() >= 5) break;
+  }
+  if (!origin || walk.size() < 5) {
+    return make_error("cannot find the initial heading from the GNSS course: fewer than 5 GNSS epoch solutions after "
+                      "the IMU started moving; set initial.yaw_deg");
+  }
+  // The chord to the mean of the last three solutions.
+  Vector3d end = Vector3d::Zero();
+  const size_t k0 = walk.size() - 3;
+  for (size_t k = k0; k < walk.size(); ++k) end += enu_from_ecef(walk[k].second, *origin);
+  end /= 3.0;
+  const double length_m = end.head<2>().norm();
+  if (length_m < 10.0) {
+    return make_error(fmt_message("cannot find the initial heading from the GNSS course: the GNSS track goes %.1f m "
+                                  "while the IMU moves (at least 10 m needed); set initial.yaw_deg",
+                                  length_m));
+  }
+  const Eigen::Vector2d u = end.head<2>() / length_m;  // east, north
+  double ss = 0.0;
+  for (const auto& w : walk) {
+    const Vector3d d = enu_from_ecef(w.second, *origin);
+    const double across = d.x() * u.y() - d.y() * u.x();
+    ss += across * across;
+  }
+  const double rms = std::sqrt(ss / static_cast<double>(walk.size()));
+  const double sigma_yaw = std::clamp(2.0 * rms / length_m, 2.0 * kDegToRad, 30.0 * kDegToRad);
+  const double yaw = std::atan2(u.x(), u.y());  // from north, clockwise (east +)
+  sum.heading_fit_rms_m = rms;
+  sum.heading_init_end = walk.back().first;
+  sum.heading_init_distance_m = length_m;
+  how += fmt_message("; no stance in the first %.0f s of motion (a hand-held or body-worn IMU): heading from the GNSS "
+                     "course over %.0f m (%zu epoch solutions until %s, RMS %.2f m across it, yaw sigma %.1f deg)",
+                     kNoStanceWindowS, length_m, walk.size(), walk.back().first.to_string().c_str(), rms,
+                     sigma_yaw * kRadToDeg);
+  return HeadingFromMotion{wrap_pi(yaw), sigma_yaw};
+}
+
+}  // namespace
+
 Expected<HeadingFromMotion> heading_from_motion(const EngineInputs& in, const EngineOptions& o,
                                                 const std::vector<ins::ZuptDecision>& decisions,
                                                 const GnssEpochUpdater& gnss, size_t start,
                                                 const ins::NavState& nav_yaw0, const ins::ImuErrors& imu0,
                                                 EngineSummary& sum, std::string& how) {
   const auto& samples = *in.imu;
+  // Without stances the INS/ZUPT track below drifts freely: the GNSS course instead (§8.2).
+  if (const size_t moving = first_motion_sample(decisions, start);
+      moving < samples.size() && shows_no_stance(samples, decisions, moving)) {
+    return heading_from_gnss_course(in, o, gnss, start, moving, nav_yaw0, sum, how);
+  }
   // Pass 1 (docs/fusion.md §8): the INS/ZUPT track with yaw 0, and at each milestone D, 2D, 4D, … of distance
   // walked (which does not depend on the heading; a GNSS track can "move" D while the person stands, by noise and
   // blunders) a 2D fit of that track onto the GNSS epoch solutions over the same span. The pass stops at the first

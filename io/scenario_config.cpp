@@ -246,6 +246,7 @@ Expected<ScenarioFile> parse_scenario_keys(const std::string& yaml_text, const s
       out.imu_spec_preset = "crista";
       read_imu_spec_entry(m, "spec", o.spec, out.imu_spec_preset);
       m.boolean("errors", o.errors);
+      m.choice("carry", o.carry, {"foot", "hand"});
       double mis_mrad = o.misalignment_sigma_rad * 1e3;
       m.number("misalignment_mrad", mis_mrad, false, 0.0, 100.0);
       o.misalignment_sigma_rad = mis_mrad * 1e-3;

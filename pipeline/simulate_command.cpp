@@ -79,7 +79,10 @@ void apply_data_sheet(const sim::Scenario& sc, const DataSheetParts& parts, RunC
     c.gnss.elevation_weight = w.elevation_weight;
     c.gnss.code_squaring_loss = w.code_squaring_loss;
   }
-  if (parts.lever_arm) {  // docs/fusion.md §14: antenna height over the foot IMU, the IMU foot beside the walking line
+  if (parts.lever_arm && sc.imu.carry == "hand") {  // the device's own antenna (docs/sim.md §9)
+    c.antenna.lever_arm_ned_m.setZero();
+    c.antenna.lever_arm_heading_m.setZero();
+  } else if (parts.lever_arm) {  // docs/fusion.md §14: antenna height over the foot IMU, the foot beside the line
     c.antenna.lever_arm_ned_m = Eigen::Vector3d(0.0, 0.0, -(sc.gnss.antenna_height_m - sc.gait.imu_height_m));
     c.antenna.lever_arm_heading_m = Eigen::Vector3d(0.0, -sc.gait.foot_offset_m, 0.0);
   }
@@ -165,6 +168,10 @@ std::string format_config(const sim::Simulation& s, const ScenarioFile& f, const
     const Eigen::Vector3d &a = ds.antenna.lever_arm_ned_m, &h = ds.antenna.lever_arm_heading_m;
     y += fmt::format("antenna:\n  lever_arm_ned_m: [{}, {}, {}]\n  lever_arm_heading_m: [{}, {}, {}]\n", a.x(), a.y(),
                      a.z(), h.x(), h.y(), h.z());
+    if (sc.imu.carry == "hand") y += "  velocity_model: foot\n";
+  } else if (any_gnss && sc.imu.carry == "hand") {
+    // A hand-held device: the antenna is the device's own, so the Doppler rows predict the IMU's velocity.
+    y += "antenna:\n  lever_arm_ned_m: [0, 0, 0]\n  velocity_model: foot\n";
   }
   if (data_sheet && data_sheet->multipath) {
     y += ds.multipath.states ? fmt::format("multipath:\n  states: true\n  sigma_m: {}\n  tau_s: {}\n  cn0_ref_dbhz: {}\n",

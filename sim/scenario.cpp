@@ -37,6 +37,8 @@ std::vector<std::string> Scenario::problems() const {
   const double ratio = imu.rate_hz / truth_rate_hz;
   if (std::abs(ratio - std::round(ratio)) > 1e-9) p.push_back("output.truth_rate_hz must divide imu.rate_hz");
   for (const auto& s : imu.spec.problems()) p.push_back("imu.spec: " + s);
+  if (imu.carry != "foot" && imu.carry != "hand") p.push_back("imu.carry: expected foot or hand, got '" + imu.carry + "'");
+  if (imu.carry == "hand" && !track.empty()) p.push_back("imu.carry: hand needs a route (not the along-a-track mode)");
   range(gnss.rate_hz, 0.1, 20.0, "gnss.rate_hz");
   range(gnss.satellites, 24, 32, "gnss.satellites");
   range(gnss.tracking_threshold_dbhz, 0.0, 60.0, "gnss.tracking_threshold_dbhz");

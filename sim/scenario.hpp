@@ -54,6 +54,10 @@ struct ImuOptions {
   /// run configuration's imu.format mounting_rpy_deg; the written samples are on the sensor axes (R_b_sᵀ ω_b).
   /// Identity: the sensor is the foot frame (z down at rest).
   Eigen::Matrix3d R_b_s = Eigen::Matrix3d::Identity();
+  /// Where the walker carries the IMU: "foot" (the foot-mounted IMU of seeds 001-004) or "hand" (a device held in
+  /// front of the body, x along the walk: the body track at hand height with a bob, sway and attitude swing at the
+  /// step and stride frequencies and no stance while walking; its GNSS antenna is the device's own; docs/sim.md §9).
+  std::string carry = "foot";
 };
 
 /// One C/N0 attenuation segment along the route distance of the walker.

@@ -9,6 +9,20 @@
 namespace pednav::sim {
 
 AntennaFunction antenna_function(const Scenario& sc, const LocalFrame& frame, const StridePlan& plan) {
+  if (sc.imu.carry == "hand") {  // the device's own antenna: the hand track (docs/sim.md §9)
+    auto hand = std::make_shared<HandTrack>(sc, plan);
+    const GpsTime t0 = sc.start;
+    return [hand, frame, t0](GpsTime t) {
+      constexpr double h = 1e-3;
+      const double ts = t - t0;
+      const HandPose a = hand->at(ts - h), b = hand->at(ts), c = hand->at(ts + h);
+      AntennaTruth r;
+      r.p_e = frame.to_e(b.p_n0);
+      r.v_e = frame.R_e_n0 * (c.p_n0 - a.p_n0) / (2.0 * h);
+      r.route_m = b.route_m;
+      return r;
+    };
+  }
   auto body = std::make_shared<BodyTrack>(plan, sc.gnss.antenna_height_m, sc.gnss.antenna_bob_m);
   const GpsTime t0 = sc.start;
   return [body, frame, t0](GpsTime t) {
@@ -42,7 +56,8 @@ Expected<Simulation> simulate(const Scenario& scenario) {
   auto plan = scenario.track.empty() ? plan_route(sim.scenario, sim.frame) : plan_track(sim.scenario, sim.frame);
   if (!plan) return plan.error();
   sim.plan = std::move(*plan);
-  sim.truth = synthesize_walk(sim.scenario, sim.frame, sim.plan);
+  sim.truth = scenario.imu.carry == "hand" ? synthesize_hand(sim.scenario, sim.frame, sim.plan)
+                                            : synthesize_walk(sim.scenario, sim.frame, sim.plan);
   sim.imu = corrupt_imu(sim.truth.imu, scenario.imu, scenario.seed, &sim.imu_errors);
   const AntennaFunction ant = antenna_function(sim.scenario, sim.frame, sim.plan);
   sim.antenna.reserve(sim.truth.nav.size());

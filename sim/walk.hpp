@@ -88,4 +88,35 @@ struct WalkTruth {
 /// (docs/sim.md §2).
 WalkTruth synthesize_walk(const Scenario& scenario, const LocalFrame& frame, const StridePlan& plan);
 
+/// A device held in the hand (ImuOptions::carry "hand", docs/sim.md §9): pose in the local frame at t_s.
+struct HandPose {
+  Eigen::Vector3d p_n0 = Eigen::Vector3d::Zero();      ///< device position, local NED [m]
+  Eigen::Matrix3d R_n0_b = Eigen::Matrix3d::Identity(); ///< device body axes (x along the walk, z down) -> local NED
+  double route_m = 0.0;                                ///< distance walked [m]
+  double speed_mps = 0.0;                              ///< horizontal speed of the body [m/s]
+};
+
+/// The hand's track: the body track at hand height, facing along the walk (the heading held while standing), with
+/// a vertical bob and pitch at the step frequency and a sideways sway, roll and yaw at the stride frequency, their
+/// amplitudes growing with the walking speed (none at rest).
+class HandTrack {
+ public:
+  HandTrack(const Scenario& scenario, const StridePlan& plan);
+  HandPose at(double t_s) const;
+
+ private:
+  BodyTrack body_;
+  double stride_hz_ = 1.0, speed_ref_mps_ = 1.0;
+  double yaw_dt_s_ = 0.05;
+  std::vector<double> yaw_;    ///< unwrapped walking direction on a yaw_dt_s_ grid from 0, smoothed
+  std::vector<double> speed_;  ///< body speed on the same grid, smoothed
+  double grid_at(const std::vector<double>& g, double t_s) const;
+};
+
+/// Synthesize the hand-held IMU along the plan: samples from the hand track's derivatives (central differences over
+/// ±1 ms) with a tracking feedback, the truth the ins mechanization of the samples themselves (as the foot's, so a
+/// mechanization of the noise-free IMU from the true initial state reproduces it); stance = 1 while the device is at
+/// rest (the walker stands and does not turn).
+WalkTruth synthesize_hand(const Scenario& scenario, const LocalFrame& frame, const StridePlan& plan);
+
 }  // namespace pednav::sim
