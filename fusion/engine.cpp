@@ -185,6 +185,7 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
   ForwardRunner runner2(in, opt, decisions);
   PassOptions po;
   po.gnss = tc;
+  if (!not_on_foot.empty()) po.hand_nhc_interval_s = 1.0;  // eq. 8.4 once per second
   const ins::NavState nav0 = ins::nav_state_at_rest(samples[s0].t, p0, level->roll, level->pitch, yaw0);
   if (auto ok = runner2.run(s0, nav0, imu0, po, result); !ok) return ok.error();
   sum.imu_samples_used = sum.imu_samples;

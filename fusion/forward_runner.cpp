@@ -137,6 +137,7 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
   ins::InsState last_stance = f.x();  // attitude and IMU errors to restart from
   gnss_.restart(/*clear_fault_history=*/false);
 
+  int64_t next_nhc_ns = 0;
   auto on_increment = [&](const ins::ImuIncrement& inc) {
     if (failed || waiting) return;
     const Vector3d p_before = f.x().nav.p_eb_e;
@@ -159,6 +160,10 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
       gnss_.update(f, gi, inc.t1, stride_, clock_initialized, sum, last_used, last_rejected,
                   o_.record_gnss_rows ? &result.gnss_rows : nullptr);
       ++gi;
+    }
+    if (po.hand_nhc_interval_s > 0.0 && inc.t1.ns() >= next_nhc_ns) {
+      StanceUpdater::hand_nhc_update(f, kHandNhcSigmaCrossMps, kHandNhcSigmaUpMps);
+      next_nhc_ns = inc.t1.ns() + std::llround(po.hand_nhc_interval_s * 1e9);
     }
     prev_zupt = zupt_now;
     std::string why;

@@ -34,7 +34,14 @@ struct PassOptions {
   /// outputs so far, the milestone) is called; the pass stops when it returns true.
   double walked_milestone_m = 0.0;
   std::function<bool(const EngineResult&, double)> at_milestone;
+  /// An IMU not on a foot (docs/fusion.md §8.2): the non-holonomic constraint of a hand-held device
+  /// (StanceUpdater::hand_nhc_update, eq. 8.4) every this many seconds; 0: off.
+  double hand_nhc_interval_s = 0.0;
 };
+
+/// Noise of the hand-held non-holonomic constraint (eq. 8.4) [m/s]: a hand's sway and bob (centimetres at the stride
+/// and step frequencies: ~0.1 and ~0.3 m/s) and its heading off the walking direction by a few degrees.
+inline constexpr double kHandNhcSigmaCrossMps = 0.2, kHandNhcSigmaUpMps = 0.3;
 
 class ForwardRunner {
  public:

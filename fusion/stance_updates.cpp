@@ -104,4 +104,27 @@ void StanceUpdater::step_velocity_update(ErrorStateFilter& f, const StepMeasurem
   H.block<3, 3>(0, ins::kAtt.offset) = rows.J_dv_phi.rightCols<3>();
   if (f.update(rows.residual, H, rows.cov_meas)) ++sum.step_velocity_updates;
 }
+HandNhcRows hand_nhc_rows(const ins::NavState& nav, double sigma_cross_mps, double sigma_up_mps) {
+  StepMeasurement m;
+  m.mean_v_e = nav.v_eb_e;  // the current velocity: the step model's ∂h/∂δv is exact here
+  StepVelocityOptions so;
+  so.sigma_cross_mps = sigma_cross_mps;
+  so.sigma_vertical_mps = sigma_up_mps;
+  const StepVelocityRows step = step_velocity_rows(nav, m, so);
+  HandNhcRows rows;
+  rows.residual = step.residual.tail<2>();
+  rows.J_dv_phi = step.J_dv_phi.bottomRows<2>();
+  rows.cov_meas = step.cov_meas.bottomRightCorner<2, 2>();
+  return rows;
+}
+
+bool StanceUpdater::hand_nhc_update(ErrorStateFilter& f, double sigma_cross_mps, double sigma_up_mps) {
+  const HandNhcRows rows = hand_nhc_rows(f.x().nav, sigma_cross_mps, sigma_up_mps);
+  Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::ColMajor, 2, ins::kMaxErrorDim> H =
+      Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::ColMajor, 2, ins::kMaxErrorDim>::Zero(2, f.layout().dim());
+  H.block<2, 3>(0, ins::kVel.offset) = rows.J_dv_phi.leftCols<3>();
+  H.block<2, 3>(0, ins::kAtt.offset) = rows.J_dv_phi.rightCols<3>();
+  return f.update(rows.residual, H, rows.cov_meas);
+}
+
 }  // namespace pednav::fusion

@@ -19,6 +19,16 @@ namespace pednav::fusion {
 /// velocity v_e [m/s]: form F: [I 0], form D: [I [v×]] (docs/fusion.md eq. 4.3; seed 001 eq. 8-9).
 Eigen::Matrix<double, 3, 6> zupt_jacobian(const Eigen::Vector3d& v_e, ZuptForm form);
 
+/// Rows of the non-holonomic constraint of a device held in the hand (docs/fusion.md eq. 8.4) at the nominal state:
+/// h(x) = [u_lᵀ v, −downᵀ v] (the cross and up rows of step_velocity_prediction at the current velocity), residual
+/// r = 0 − h(x̂), Jacobian w.r.t. [δv, φ] and the noise diag(σ_cross², σ_up²).
+struct HandNhcRows {
+  Eigen::Vector2d residual = Eigen::Vector2d::Zero();
+  Eigen::Matrix<double, 2, 6> J_dv_phi = Eigen::Matrix<double, 2, 6>::Zero();
+  Eigen::Matrix2d cov_meas = Eigen::Matrix2d::Zero();
+};
+HandNhcRows hand_nhc_rows(const ins::NavState& nav, double sigma_cross_mps, double sigma_up_mps);
+
 class StanceUpdater {
  public:
   explicit StanceUpdater(const EngineOptions& o);
@@ -31,6 +41,11 @@ class StanceUpdater {
   /// Step-averaged velocity (seed 000 eq. 3): along/cross-track/vertical average velocity of the step vs ΔL/T,
   /// applied at the stance onset that ends the step; state blocks: velocity and attitude (fusion/step_velocity.hpp).
   void step_velocity_update(ErrorStateFilter& f, const StepMeasurement& m, EngineSummary& sum);
+
+  /// Non-holonomic constraint of a device held in the hand (docs/fusion.md eq. 8.4): its velocity has no component
+  /// across its horizontal heading (σ sigma_cross_mps) and none vertical (σ sigma_up_mps) — the cross and up rows of
+  /// the step-velocity model (step_velocity_rows) at the current velocity. True when the update was applied.
+  static bool hand_nhc_update(ErrorStateFilter& f, double sigma_cross_mps, double sigma_up_mps);
 
  private:
   // ZARU rows: the measured rate (corrected by the current bias estimate) should equal the Earth rate in b; residual

@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 #include "core/geodesy.hpp"
 #include "core/rotation.hpp"
+#include "fusion/stance_updates.hpp"
 #include "fusion/step_velocity.hpp"
 #include "ins/alignment.hpp"
 #include "tests/support/numdiff.hpp"
@@ -67,6 +69,32 @@ TEST(StepVelocity, JacobianMatchesNumericalDifferentiation) {
   EXPECT_NEAR(pred.x(), 1.0, 1e-9);
   EXPECT_NEAR(pred.y(), 0.5, 1e-9);
   EXPECT_NEAR(pred.z(), 0.2, 1e-9);
+}
+
+// The hand-held non-holonomic constraint (docs/fusion.md eq. 8.4): h(x) = the cross and up components of the current
+// velocity, its Jacobian against central differences through the boxplus, its residual 0 − h and its noise.
+TEST(HandNhc, JacobianMatchesNumericalDifferentiation) {
+  const Geodetic llh{51.08 * kDegToRad, -114.13 * kDegToRad, 1050.0};
+  const Eigen::Vector3d p_e = ecef_from_geodetic(llh);
+  const Eigen::Matrix3d Ren = R_e_n(llh.lat, llh.lon);
+  for (const auto& [rpy, v_n] : {std::pair{Eigen::Vector3d(0.03, -0.05, 0.7), Eigen::Vector3d(1.1, 0.9, 0.02)},
+                                 std::pair{Eigen::Vector3d(-0.2, 0.3, -2.5), Eigen::Vector3d(-1.2, -0.4, -0.1)}}) {
+    ins::NavState nav = ins::nav_state_at_rest(GpsTime::from_week_tow(2300, 10.0), p_e, rpy.x(), rpy.y(), rpy.z());
+    nav.v_eb_e = Ren * v_n;
+    const HandNhcRows rows = hand_nhc_rows(nav, 0.2, 0.3);
+    const Eigen::Matrix3d R = nav.R_e_b();
+    auto f = [&](const Eigen::VectorXd& dx) -> Eigen::VectorXd {
+      return step_velocity_prediction(nav.v_eb_e + dx.head<3>(), so3_exp(dx.tail<3>()) * R, p_e).tail<2>();
+    };
+    const Eigen::MatrixXd J = test::numerical_jacobian(f, Eigen::VectorXd::Zero(6), kNumDiffStep);
+    EXPECT_LT((J - rows.J_dv_phi).cwiseAbs().maxCoeff(), kJacobianTol) << "num\n" << J << "\nana\n" << rows.J_dv_phi;
+    const Eigen::Vector3d pred = step_velocity_prediction(nav.v_eb_e, R, p_e);
+    EXPECT_NEAR(rows.residual.x(), -pred.y(), 1e-12);
+    EXPECT_NEAR(rows.residual.y(), -pred.z(), 1e-12);
+    EXPECT_DOUBLE_EQ(rows.cov_meas(0, 0), 0.04);
+    EXPECT_DOUBLE_EQ(rows.cov_meas(1, 1), 0.09);
+    EXPECT_DOUBLE_EQ(rows.cov_meas(0, 1), 0.0);
+  }
 }
 
 TEST(StepVelocity, TrackerSegmentsStepsAtStanceOnsets) {

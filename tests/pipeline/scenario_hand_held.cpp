@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // A hand-held IMU with GNSS (issue 49 item 4; datasets/forest_walk_hand.yaml: forest_walk's route, receiver, canopy and
 // seed with the device in the hand, docs/sim.md §9): the engine recognizes an IMU that is not on a foot (no ZUPT after
-// the levelling window, heading from the GNSS course, the Doppler rows on the IMU's own velocity; docs/fusion.md §8.2)
-// and the tight coupling does better than `pednav gnss` on the same files.
+// the levelling window, heading from the GNSS course, the Doppler rows on the IMU's own velocity, the non-holonomic
+// constraint of a hand; docs/fusion.md §8.2) and the tight coupling does better than `pednav gnss` on the same files.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -52,14 +52,15 @@ std::map<int, double> window_rms(const eval::Evaluation& ev) {
   return out;
 }
 
-// Measured 2026-12-06 (Release, deterministic): `pednav gnss` 4.62 m horizontal RMS; `pednav run` forward 2.27 m
-// (0.49x), smoothed 1.74 m (0.38x); of the 18 one-minute windows the forward solution is above the GNSS-only one in 2
-// (the first, standing at the start: 0.39 against 0.35 m; and 360-420 s, 1.93 against 1.15 m, where the heading of the
-// device, unobserved while it walks straight without ZUPT, is 6-11° off). Issue 49's target: <= 0.8x over the whole
-// walk (met) and never above over any 60-s window (not met: 2 of 18). Bounds: the measured ratios + 15 %, the count of
-// windows above exactly.
-constexpr double kForwardRatio = 0.49, kSmoothedRatio = 0.38;
-constexpr int kWindowsAbove = 2;
+// Measured 2026-12-06 (Release, deterministic): `pednav gnss` 4.62 m horizontal RMS; `pednav run` forward 1.76 m
+// (0.38x), smoothed 1.15 m (0.25x). Of the 18 one-minute windows the forward solution is above the GNSS-only one in 2
+// (the first, standing at the start: 0.39 against 0.35 m; 360-420 s: 1.51 against 1.15 m), the smoothed one in none.
+// Without the hand-held non-holonomic constraint (eq. 8.4): forward 2.27 m (0.49x), smoothed 1.74 m (0.38x); before
+// the not-on-foot recognition the run did not initialize (heading from an INS/ZUPT track that never had a ZUPT).
+// Issue 49's target: <= 0.8x over the whole walk (met) and never above over any 60-s window (smoothed: met; forward:
+// 2 of 18). Bounds: the measured ratios + 15 % (below the figures without the constraint), the window counts exactly.
+constexpr double kForwardRatio = 0.38, kSmoothedRatio = 0.25;
+constexpr int kForwardWindowsAbove = 2, kSmoothedWindowsAbove = 0;
 
 TEST(HandHeld, TheTightCouplingOfAHandHeldImuBeatsTheGnssEpochSolution) {
   auto file = io::load_scenario(test::source_path("datasets/forest_walk_hand.yaml"));
@@ -84,21 +85,23 @@ TEST(HandHeld, TheTightCouplingOfAHandHeldImuBeatsTheGnssEpochSolution) {
   const auto s = compare(dir + "/run/smoothed.csv", truth, dir + "/cmp_smo");
   ASSERT_GT(g.horizontal_rms_m, 0.0);
   const double rf = f.horizontal_rms_m / g.horizontal_rms_m, rs = s.horizontal_rms_m / g.horizontal_rms_m;
-  const auto wg = window_rms(g), wf = window_rms(f);
-  int above = 0, windows = 0;
+  const auto wg = window_rms(g), wf = window_rms(f), ws = window_rms(s);
+  int above_f = 0, above_s = 0, windows = 0;
   for (const auto& [w, r] : wf) {
-    if (!wg.count(w)) continue;
+    if (!wg.count(w) || !ws.count(w)) continue;
     ++windows;
-    above += r > wg.at(w);
+    above_f += r > wg.at(w);
+    above_s += ws.at(w) > wg.at(w);
   }
-  std::printf("[hand-held forest walk] gnss %.2f m, tc forward %.2f m (%.2fx), smoothed %.2f m (%.2fx); forward above "
-              "gnss in %d of %d 60-s windows\n",
-              g.horizontal_rms_m, f.horizontal_rms_m, rf, s.horizontal_rms_m, rs, above, windows);
+  std::printf("[hand-held forest walk] gnss %.2f m, tc forward %.2f m (%.2fx), smoothed %.2f m (%.2fx); above gnss in "
+              "%d (forward) and %d (smoothed) of %d 60-s windows\n",
+              g.horizontal_rms_m, f.horizontal_rms_m, rf, s.horizontal_rms_m, rs, above_f, above_s, windows);
   EXPECT_LT(rf, 0.8);  // issue 49
   EXPECT_LT(rf, kForwardRatio * 1.15);
   EXPECT_LT(rs, kSmoothedRatio * 1.15);
   EXPECT_EQ(windows, 18);
-  EXPECT_EQ(above, kWindowsAbove);
+  EXPECT_EQ(above_f, kForwardWindowsAbove);
+  EXPECT_EQ(above_s, kSmoothedWindowsAbove);
 }
 
 }  // namespace
