@@ -48,6 +48,17 @@ constexpr double kVrwMeasured_mps_per_sqrt_h[3] = {0.3537, 0.3521, 0.3531};
 constexpr double kMeasuredNoiseTolerance = 0.03;
 constexpr double kTiltMeasured_deg = 30.204;
 
+// `pednav compare --loop` of DIR/run/solution.csv against DIR/truth.csv (no plots).
+Expected<eval::Evaluation> compare_loop(const std::string& dir) {
+  pipeline::CompareArgs args;
+  args.solution = dir + "/run/solution.csv";
+  args.reference = dir + "/truth.csv";
+  args.out_dir = dir + "/cmp";
+  args.compare.loop = true;
+  args.plots = false;
+  return pipeline::run_compare(args);
+}
+
 TEST(UnknownSensor, CalibrateRecoversTheSensorAndAutoClosesTheLoop) {
   auto file = io::load_scenario(test::source_path("datasets/unknown_sensor.yaml"));
   ASSERT_TRUE(file) << file.error().message;
@@ -116,13 +127,7 @@ TEST(UnknownSensor, CalibrateRecoversTheSensorAndAutoClosesTheLoop) {
   }
   auto sum = pipeline::run_run_command(*cfg, dir + "/run");
   ASSERT_TRUE(sum) << sum.error().message;
-  pipeline::CompareArgs args;
-  args.solution = dir + "/run/solution.csv";
-  args.reference = dir + "/truth.csv";
-  args.out_dir = dir + "/cmp";
-  args.compare.loop = true;
-  args.plots = false;
-  auto ev = pipeline::run_compare(args);
+  auto ev = compare_loop(dir);
   ASSERT_TRUE(ev) << ev.error().message;
   std::printf("[unknown sensor, auto] closure %.3f m = %.2f %% of %.1f m, RMS %.3f m\n", ev->closure_m,
               ev->closure_pct_of_distance, ev->distance_m, ev->horizontal_rms_m);
@@ -171,13 +176,7 @@ TEST(UnknownSensor, AnAccelerometerOffOneGAtRestStillCalibratesAndClosesTheLoop)
   std::ifstream js(dir + "/run/summary.json");
   const auto summary = nlohmann::json::parse(js);
   EXPECT_TRUE(summary["self_calibration"]["calibration"]["bias_estimated"].get<bool>());
-  pipeline::CompareArgs args;
-  args.solution = dir + "/run/solution.csv";
-  args.reference = dir + "/truth.csv";
-  args.out_dir = dir + "/cmp";
-  args.compare.loop = true;
-  args.plots = false;
-  auto ev = pipeline::run_compare(args);
+  auto ev = compare_loop(dir);
   ASSERT_TRUE(ev) << ev.error().message;
   std::printf("[unknown sensor, seed 2] closure %.2f %% of %.1f m, RMS %.3f m\n", ev->closure_pct_of_distance,
               ev->distance_m, ev->horizontal_rms_m);
@@ -219,13 +218,7 @@ MinimalRun run_minimal(const std::string& scenario, const std::string& name) {
   EXPECT_TRUE(cfg->imu.spec_auto && cfg->zupt.shoe_threshold_auto);
   auto sum = pipeline::run_run_command(*cfg, dir + "/run");
   EXPECT_TRUE(sum) << sum.error().message;
-  pipeline::CompareArgs args;
-  args.solution = dir + "/run/solution.csv";
-  args.reference = dir + "/truth.csv";
-  args.out_dir = dir + "/cmp";
-  args.compare.loop = true;
-  args.plots = false;
-  auto ev = pipeline::run_compare(args);
+  auto ev = compare_loop(dir);
   EXPECT_TRUE(ev) << ev.error().message;
   if (ev) out.ev = *ev;
   std::ifstream js(dir + "/run/summary.json");
