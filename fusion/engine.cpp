@@ -30,6 +30,33 @@ namespace {
 // not on a foot.
 constexpr double kFootSwingRateRadps = 2.0;
 constexpr double kNotOnFootMaxSwingShare = 0.005;
+// ... and the IMU itself walks: |f| scatters by more than kWalkingAccelStdMps2 (the step's bob and impact; a hand
+// ±2-3 m/s², a foot or pocket more) in at least kWalkingWindowShare of the 1-s windows after the levelling window,
+// so that a foot IMU at rest under a GNSS track that wanders (multipath, blunders) keeps its ZUPTs.
+constexpr double kWalkingAccelStdMps2 = 0.5;
+constexpr double kWalkingWindowShare = 0.3;
+
+// Share of the 1-s windows of samples [begin, end) whose |f| has a standard deviation above kWalkingAccelStdMps2.
+double walking_window_share(const std::vector<ins::ImuSample>& samples, size_t begin) {
+  int windows = 0, walking = 0;
+  size_t i = begin;
+  while (i < samples.size()) {
+    double sum = 0.0, sum2 = 0.0;
+    size_t n = 0;
+    const GpsTime t0 = samples[i].t;
+    for (; i < samples.size() && samples[i].t - t0 < 1.0; ++i, ++n) {
+      const double f = samples[i].f_ib_b.norm();
+      sum += f;
+      sum2 += f * f;
+    }
+    if (n < 2) continue;
+    const double mean = sum / static_cast<double>(n);
+    const double var = std::max(0.0, sum2 / static_cast<double>(n) - mean * mean);
+    ++windows;
+    walking += std::sqrt(var) > kWalkingAccelStdMps2;
+  }
+  return windows > 0 ? static_cast<double>(walking) / windows : 0.0;
+}
 constexpr double kNotOnFootMinTrackM = 20.0;
 
 // Largest horizontal distance of the GNSS epoch solutions (every 10th epoch from t_start) from the first one [m];
@@ -101,7 +128,8 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
     // levelling window, and the Doppler rows see the IMU's own velocity.
     size_t swings = 0;
     for (size_t i = s1; i < samples.size(); ++i) swings += samples[i].omega_ib_b.norm() > kFootSwingRateRadps;
-    if (static_cast<double>(swings) < kNotOnFootMaxSwingShare * static_cast<double>(samples.size() - s1)) {
+    if (static_cast<double>(swings) < kNotOnFootMaxSwingShare * static_cast<double>(samples.size() - s1) &&
+        walking_window_share(samples, s1) >= kWalkingWindowShare) {
       const double moved_m = gnss_track_extent(in, o, samples[s0].t);
       if (moved_m >= kNotOnFootMinTrackM) {
         for (size_t i = s1; i < decisions.size(); ++i) decisions[i].stance = false;
