@@ -55,5 +55,20 @@ TEST(ScenarioSpec, UnknownKeyOrPresetInTheMapIsAnError) {
   EXPECT_THAT(bad_preset.error().message, HasSubstr("cristal"));
 }
 
+// imu.carry (docs/sim.md §9): foot (default) or hand; anything else names the file, line and key.
+TEST(ScenarioSpec, CarryIsFootOrHand) {
+  const std::string dir = std::string(PEDNAV_SOURCE_DIR) + "/datasets";
+  const auto foot = parse_scenario(forest_walk_with_spec("  spec: crista"), "scenario.yaml", dir);
+  ASSERT_TRUE(foot) << foot.error().message;
+  EXPECT_EQ(foot->scenario.imu.carry, "foot");
+  const auto hand = parse_scenario(forest_walk_with_spec("  spec: crista\n  carry: hand"), "scenario.yaml", dir);
+  ASSERT_TRUE(hand) << hand.error().message;
+  EXPECT_EQ(hand->scenario.imu.carry, "hand");
+  const auto pocket = parse_scenario(forest_walk_with_spec("  spec: crista\n  carry: pocket"), "scenario.yaml", dir);
+  ASSERT_FALSE(pocket);
+  EXPECT_THAT(pocket.error().message, HasSubstr("scenario.yaml:"));
+  EXPECT_THAT(pocket.error().message, HasSubstr("imu.carry: expected one of {foot, hand}, got 'pocket'"));
+}
+
 }  // namespace
 }  // namespace pednav::io
