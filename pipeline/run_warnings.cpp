@@ -7,8 +7,10 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/geodesy.hpp"
+#include "eval/trajectory.hpp"
 
 namespace pednav::pipeline {
 namespace {
@@ -177,12 +179,7 @@ std::vector<RunWarning> imu_log_warnings(const std::vector<ins::ImuSample>& samp
     f.push_back(std::abs(samples[i].f_ib_b.norm() - kStandardGravity));
     if (i > 0) dt.push_back(samples[i].t - samples[i - 1].t);
   }
-  auto quantile = [](std::vector<double> v, double q) {
-    const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())));
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-    return v[k];
-  };
-  const double w999 = quantile(w, 0.999), f99 = quantile(f, 0.99);
+  const double w999 = eval::quantile(std::move(w), 0.999), f99 = eval::quantile(std::move(f), 0.99);
   if (w999 > l.gyro_max_plausible_radps) {
     out.push_back({"gyro_unit",
                    fmt::format("gyro rates reach {:.0f} rad/s (99.9th percentile; a foot's swing peaks at 5-15 rad/s, "

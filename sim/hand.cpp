@@ -6,17 +6,15 @@
 
 #include "core/geodesy.hpp"
 #include "core/rotation.hpp"
-#include "ins/gravity.hpp"
 #include "ins/mechanization.hpp"
 #include "sim/walk.hpp"
 
 namespace pednav::sim {
 namespace {
 
-const Eigen::Vector3d kOmegaIE_e(0.0, 0.0, wgs84::kOmegaIE_radps);
 // The hand: 1.1 m above the ground, 0.3 m ahead of the body; at the reference walking speed it bobs ±2.5 cm and
 // pitches ±3° at the step frequency (twice per stride), sways ±2 cm sideways and rolls ±3° and yaws ±2° at the
-// stride frequency. Amplitudes scale with speed / the gait's speed (none at rest).
+// stride frequency; the amplitudes follow a smoothstep of the walking speed over the gait's (none at rest).
 constexpr double kHandHeightM = 1.1, kHandAheadM = 0.3;
 constexpr double kBobM = 0.025, kSwayM = 0.02;
 constexpr double kPitchRad = 3.0 * kDegToRad, kRollRad = 3.0 * kDegToRad, kYawRad = 2.0 * kDegToRad;
@@ -107,10 +105,8 @@ HandPose HandTrack::at(double t_s) const {
 namespace {
 
 // The designed kinematics of the hand at ts (central differences of the track over ±kDiffStepS).
-struct HandDesign {
-  Eigen::Vector3d p_e, v_e, a_e, omega_nb_b;
-  Eigen::Matrix3d R_e_b;
-  double speed_mps;
+struct HandDesign : DesignedMotion {
+  double speed_mps = 0.0;
 };
 
 HandDesign hand_design(const HandTrack& hand, const LocalFrame& frame, double ts) {
@@ -127,17 +123,12 @@ HandDesign hand_design(const HandTrack& hand, const LocalFrame& frame, double ts
   return d;
 }
 
-// Tracking feedback of the truth onto the design (as the foot's swing in sim/walk.cpp): critically damped, 20 rad/s.
-constexpr double kTrackPos_per_s2 = 400.0, kTrackVel_per_s = 40.0, kTrackAtt_per_s = 20.0;
-
 }  // namespace
 
 WalkTruth synthesize_hand(const Scenario& sc, const LocalFrame& frame, const StridePlan& plan) {
   WalkTruth out;
   const HandTrack hand(sc, plan);
   const double rate = sc.imu.rate_hz;
-  const int64_t period_ns = std::llround(1e9 / rate);
-  const bool whole_ns_period = std::abs(1e9 / rate - static_cast<double>(period_ns)) <= 1e-6;
   const long n = std::lround(plan.duration_s * rate) + 1;
   out.imu.reserve(static_cast<size_t>(n));
   out.nav.reserve(static_cast<size_t>(n));
@@ -147,30 +138,20 @@ WalkTruth synthesize_hand(const Scenario& sc, const LocalFrame& frame, const Str
   ins::IncrementIntegrator integ(io);
   ins::NavState x;
   for (long k = 0; k < n; ++k) {
-    const int64_t offset_ns =
-        whole_ns_period ? k * period_ns : std::llround(static_cast<long double>(k) * 1e9L / rate);
+    const int64_t offset_ns = imu_sample_offset_ns(k, rate);
     const GpsTime t = sc.start.plus_ns(offset_ns);
     const double ts = static_cast<double>(offset_ns) * 1e-9;
     const HandDesign d = hand_design(hand, frame, ts);
-    Eigen::Vector3d a_fb = Eigen::Vector3d::Zero(), att_fb = Eigen::Vector3d::Zero();
     if (k == 0) {
       x.t = t;
       x.p_eb_e = d.p_e;
       x.v_eb_e = d.v_e;
       x.q_e_b = Eigen::Quaterniond(d.R_e_b).normalized();
-    } else {
-      // The truth is the mechanization of these very samples; the feedback keeps it on the design.
-      const ins::NavState& prev = out.nav.back();
-      const double ts_prev = static_cast<double>(prev.t - sc.start);
-      const HandDesign dp = hand_design(hand, frame, ts_prev);
-      a_fb = kTrackPos_per_s2 * (dp.p_e - prev.p_eb_e) + kTrackVel_per_s * (dp.v_e - prev.v_eb_e);
-      att_fb = kTrackAtt_per_s * so3_log(prev.R_e_b().transpose() * dp.R_e_b);
     }
-    const Eigen::Matrix3d R_b_e = d.R_e_b.transpose();
-    ins::ImuSample m;
-    m.t = t;
-    m.omega_ib_b = d.omega_nb_b + R_b_e * kOmegaIE_e + att_fb;
-    m.f_ib_b = R_b_e * (d.a_e + a_fb + 2.0 * kOmegaIE_e.cross(d.v_e) - ins::gravity_ecef(d.p_e));
+    // The truth is the mechanization of these very samples; the feedback keeps it on the design.
+    const ins::NavState* prev = k == 0 ? nullptr : &out.nav.back();
+    const ins::ImuSample m =
+        tracked_sample(t, d, prev, prev ? hand_design(hand, frame, static_cast<double>(prev->t - sc.start)) : d);
     if (k == 0) {
       integ.push(m, [](const ins::ImuIncrement&) {});
     } else {

@@ -17,9 +17,6 @@ const Eigen::Vector3d kOmegaIE_e(0.0, 0.0, wgs84::kOmegaIE_radps);
 constexpr double kStanceVelocityDamping_s = 0.1;  // stance: residual truth velocity decays with this time constant
 constexpr double kTurnLandingThreshold_rad = 20.0 * kDegToRad;  // waypoint turns above this get a landing on it
 constexpr double kHeadingChord_m = 0.3;          // chord half-length for the path heading at a landing
-constexpr double kTrackPos_per_s2 = 400.0;       // swing tracking feedback: natural frequency 20 rad/s,
-constexpr double kTrackVel_per_s = 40.0;         // critically damped
-constexpr double kTrackAtt_per_s = 20.0;         // attitude tracking [1/s]
 
 // C3 smooth step (7th-order, zero 1st-3rd derivatives at both ends) and its derivatives in s.
 struct Poly {
@@ -152,10 +149,7 @@ struct Planner {
 // The designed swing at time ts (seconds after the start): analytic position, velocity, acceleration,
 // attitude and body rate. Position: smooth step from the lift-off point to the landing point plus a lift lobe;
 // attitude: z-y-x Euler angles (roll/pitch lobes, yaw smooth step) in the local NED frame n0.
-struct Design {
-  Eigen::Vector3d p_e, v_e, a_e, omega_nb_b;
-  Eigen::Matrix3d R_e_b;
-};
+using Design = DesignedMotion;
 Design design(const Stride& st, const Eigen::Vector3d& pA, const Eigen::Vector3d& eulerA, double ts, const LocalFrame& frame) {
   const double T = st.swing_s, s = std::clamp((ts - st.t_lift_s) / T, 0.0, 1.0);
   const Poly sg = smooth_step(s), b0 = bump(s, 0.0, 1.0), b1 = bump(s, 0.0, kPitchDownEnd), b2 = bump(s, kPitchUpStart, 1.0);
@@ -346,16 +340,32 @@ void BodyTrack::antenna_n0(double t_s, Eigen::Vector3d& p, Eigen::Vector3d& v, d
   }
 }
 
+int64_t imu_sample_offset_ns(long k, double rate_hz) {
+  const int64_t period_ns = std::llround(1e9 / rate_hz);
+  if (std::abs(1e9 / rate_hz - static_cast<double>(period_ns)) <= 1e-6) return k * period_ns;
+  return std::llround(static_cast<long double>(k) * 1e9L / rate_hz);
+}
+
+ins::ImuSample tracked_sample(GpsTime t, const DesignedMotion& d, const ins::NavState* prev,
+                              const DesignedMotion& d_prev) {
+  constexpr double kTrackPos_per_s2 = 400.0;  // natural frequency 20 rad/s, critically damped
+  constexpr double kTrackVel_per_s = 40.0;
+  constexpr double kTrackAtt_per_s = 20.0;    // attitude [1/s]
+  Eigen::Vector3d a_fb = Eigen::Vector3d::Zero(), att_fb = Eigen::Vector3d::Zero();
+  if (prev) {
+    a_fb = kTrackPos_per_s2 * (d_prev.p_e - prev->p_eb_e) + kTrackVel_per_s * (d_prev.v_e - prev->v_eb_e);
+    att_fb = kTrackAtt_per_s * so3_log(prev->R_e_b().transpose() * d_prev.R_e_b);
+  }
+  ins::ImuSample m;
+  m.t = t;
+  m.omega_ib_b = d.omega_nb_b + d.R_e_b.transpose() * kOmegaIE_e + att_fb;  // the local frame is fixed to the Earth
+  m.f_ib_b = d.R_e_b.transpose() * (d.a_e + a_fb + 2.0 * kOmegaIE_e.cross(d.v_e) - ins::gravity_ecef(d.p_e));
+  return m;
+}
+
 WalkTruth synthesize_walk(const Scenario& sc, const LocalFrame& frame, const StridePlan& plan) {
   WalkTruth out;
   const double rate = sc.imu.rate_hz;
-  // Sample k at k periods after the start, to the nanosecond: exact for rates whose period is a whole number of
-  // nanoseconds, rounded (±0.5 ns) for the others (60 Hz); the truth is the mechanization of these very samples.
-  const int64_t period_ns = std::llround(1e9 / rate);
-  const bool whole_ns_period = std::abs(1e9 / rate - static_cast<double>(period_ns)) <= 1e-6;
-  auto sample_offset_ns = [&](long k) -> int64_t {
-    return whole_ns_period ? k * period_ns : std::llround(static_cast<long double>(k) * 1e9L / rate);
-  };
   const long n = std::lround(plan.duration_s * rate) + 1;
   out.imu.reserve(static_cast<size_t>(n));
   out.nav.reserve(static_cast<size_t>(n));
@@ -385,7 +395,7 @@ WalkTruth synthesize_walk(const Scenario& sc, const LocalFrame& frame, const Str
   Eigen::Vector3d pA = Eigen::Vector3d::Zero(), eulerA = Eigen::Vector3d::Zero();
   long anchored = -1;
   for (long k = 0; k < n; ++k) {
-    const GpsTime t = sc.start.plus_ns(sample_offset_ns(k));
+    const GpsTime t = sc.start.plus_ns(imu_sample_offset_ns(k, rate));
     const double ts = static_cast<double>(k) / rate;
     while (si < plan.strides.size() && k > std::lround((plan.strides[si].t_lift_s + plan.strides[si].swing_s) * rate)) ++si;
     ins::ImuSample m;
@@ -404,13 +414,7 @@ WalkTruth synthesize_walk(const Scenario& sc, const LocalFrame& frame, const Str
         const Design d = design(st, pA, eulerA, ts, frame);
         // Tracking feedback on the truth at the previous sample keeps the integrated truth on the design
         // (integration error of the sampled rates); the truth stays the mechanization of these very samples.
-        const ins::NavState& prev = out.nav.back();
-        const Design dp = design(st, pA, eulerA, ts - 1.0 / rate, frame);
-        const Eigen::Vector3d a_fb = kTrackPos_per_s2 * (dp.p_e - prev.p_eb_e) + kTrackVel_per_s * (dp.v_e - prev.v_eb_e);
-        const Eigen::Vector3d att_fb = kTrackAtt_per_s * so3_log(prev.R_e_b().transpose() * dp.R_e_b);
-        m.t = t;
-        m.omega_ib_b = d.omega_nb_b + d.R_e_b.transpose() * kOmegaIE_e + att_fb;  // n0 is fixed to the Earth
-        m.f_ib_b = d.R_e_b.transpose() * (d.a_e + a_fb + 2.0 * kOmegaIE_e.cross(d.v_e) - ins::gravity_ecef(d.p_e));
+        m = tracked_sample(t, d, &out.nav.back(), design(st, pA, eulerA, ts - 1.0 / rate, frame));
       }
     }
     if (!in_swing) m = stance_sample(k == 0 ? x : out.nav.back(), t);

@@ -81,6 +81,23 @@ struct WalkTruth {
   std::vector<uint8_t> stance;       ///< 1 when the foot is flat (not inside a swing)
 };
 
+/// Offset of IMU sample k from the scenario start [ns]: k periods, exact for a rate whose period is a whole number of
+/// nanoseconds, rounded to the nanosecond (±0.5 ns) for the others (60 Hz).
+int64_t imu_sample_offset_ns(long k, double rate_hz);
+
+/// A designed motion at one instant (ECEF): position, velocity, acceleration, body rate w.r.t. the Earth-fixed local
+/// frame on the body axes, attitude.
+struct DesignedMotion {
+  Eigen::Vector3d p_e, v_e, a_e, omega_nb_b;
+  Eigen::Matrix3d R_e_b;
+};
+
+/// The exact IMU sample of the design `d` at t, plus a tracking feedback (critically damped, 20 rad/s) of the truth
+/// `prev` at the previous sample onto the design there (`d_prev`), which keeps a truth integrated from the samples on
+/// the design (docs/sim.md §2); prev == nullptr: no feedback.
+ins::ImuSample tracked_sample(GpsTime t, const DesignedMotion& d, const ins::NavState* prev,
+                              const DesignedMotion& d_prev);
+
 /// Synthesize the IMU along the plan. Each sample is computed from the designed motion (swing: analytic
 /// derivatives of the smooth design anchored at the truth state at lift-off; stance: Earth rate and gravity at
 /// the truth state, with a 0.1 s velocity damping), and the truth is the ins mechanization of the samples
