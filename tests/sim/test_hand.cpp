@@ -100,6 +100,13 @@ TEST(HandCarry, ACarryThatIsNeitherFootNorHandIsNamed) {
   ASSERT_FALSE(s);
   EXPECT_NE(s.error().message.find("imu.carry: expected foot or hand, got 'pocket'"), std::string::npos)
       << s.error().message;
+  // The along-a-track mode gives the antenna's track, not a walker's body: no hand to carry the device.
+  sc.imu.carry = "hand";
+  sc.track.resize(2);
+  sc.track[1].t = sc.track[0].t.plus_s(1.0);
+  const auto problems = sc.problems();
+  EXPECT_NE(std::find(problems.begin(), problems.end(), "imu.carry: hand needs a route (not the along-a-track mode)"),
+            problems.end());
 }
 
 }  // namespace
