@@ -50,7 +50,7 @@ void CarrierUpdater::restart_all(ErrorStateFilter& f, gnss::SlipReason why, Engi
 CarrierEpoch CarrierUpdater::update(ErrorStateFilter& f, const gnss::ObsEpoch& re, const gnss::ObsEpoch& be,
                                     int base_index, double age_s, const Vector3d& p_a_e, const LeverArm& arm,
                                     const Eigen::Matrix3d& C_pos_e, const std::vector<int>& clock_slot_of_system,
-                                    const std::map<gnss::SatId, double>& code_sigma, EngineSummary& sum) {
+                                    const std::map<gnss::SatId, double>& code_sigma, EngineSummary& sum, int pos_col) {
   CarrierEpoch out;
   if (!nav_ || !o_.base_position_e || f.ambiguity_slots() == 0) return out;
   const int n = f.layout().dim();
@@ -143,8 +143,8 @@ CarrierEpoch CarrierUpdater::update(ErrorStateFilter& f, const gnss::ObsEpoch& r
                          gnss::carrier_sigma_m(o_.weights, o_.carrier_sigma_zenith_m, bo.cn0_dbhz, el_b),
                          o_.carrier_base_age_sigma_mps * age_s);
     r.h = Eigen::RowVectorXd::Zero(n);
-    r.h.segment<3>(ins::kPos.offset) = ph.J_p;
-    r.h.segment<3>(ins::kAtt.offset) = ph.J_p * arm.d_arm_d_phi_e;  // docs/fusion.md eq. 14.2
+    r.h.segment<3>(pos_col) = ph.J_p;
+    if (pos_col == ins::kPos.offset) r.h.segment<3>(ins::kAtt.offset) = ph.J_p * arm.d_arm_d_phi_e;  // docs/fusion.md eq. 14.2
     r.h(f.clock_offset(clock_slot)) = 1.0;
     const int ai = f.ambiguity_offset() + k;
     if (is_new) {
@@ -173,7 +173,7 @@ CarrierEpoch CarrierUpdater::update(ErrorStateFilter& f, const gnss::ObsEpoch& r
       H.row(i) = rows[i].h;
       r(i) = rows[i].residual;
       var(i) = rows[i].sigma * rows[i].sigma;
-      Jant.row(i) = rows[i].h.segment<3>(ins::kPos.offset);
+      Jant.row(i) = rows[i].h.segment<3>(pos_col);
     }
     // The non-rigid antenna offset, common to every satellite, and the receiver clocks' phase term (eq. 8.2): the
     // phase rows use the base at its own epoch, the code rows the base moved to the rover epoch with its Doppler,
@@ -249,9 +249,19 @@ CarrierEpoch CarrierUpdater::update(ErrorStateFilter& f, const gnss::ObsEpoch& r
   if (valid) {
     // Eq. 3.7: each phase residual at the fixed state (the update's and the fix's corrections together).
     const VectorXd move = dx_upd + (xf - x);
+    VectorXd e(m);
+    for (int i = 0; i < m; ++i) e(i) = rows[i].residual - (rows[i].h * move)(0);
+    // The common phase term of eq. 8.2 (σ_c: the differential clock of the phase rows is not the code's) is not
+    // estimated: it stays in every residual of a constellation alike. The test is on the residuals less their
+    // constellation's mean (between-satellite differences, which the integers are about).
     for (int i = 0; i < m; ++i) {
-      const double e = rows[i].residual - (rows[i].h * move)(0);
-      if (std::abs(e) / rows[i].sigma > o_.ambiguity.validation_w) valid = false;
+      double sum_e = 0.0;
+      int count = 0;
+      for (int j = 0; j < m; ++j) {
+        if (rows[j].sat.system == rows[i].sat.system) sum_e += e(j), ++count;
+      }
+      const double d = count > 1 ? e(i) - sum_e / count : 0.0;
+      if (std::abs(d) / rows[i].sigma > o_.ambiguity.validation_w) valid = false;
     }
   }
   if (!valid) {

@@ -41,11 +41,12 @@ class CarrierUpdater {
   /// The phase update of rover epoch `re` (masked, time-tagged) with base epoch `be` (base_index into the base
   /// epochs; be may be a Doppler-propagated copy) whose age is age_s, on filter f at the antenna p_a_e [m, ECEF]
   /// with the lever arm `arm` (its attitude Jacobian), the common antenna position noise C_pos_e [m²], the code σ of
-  /// each satellite (for a new ambiguity's variance). Counts into sum.
+  /// each satellite (for a new ambiguity's variance). pos_col: the first column of the position the rows measure
+  /// (the foot's, or the antenna states' of docs/carrier.md §10). Counts into sum.
   CarrierEpoch update(ErrorStateFilter& f, const gnss::ObsEpoch& re, const gnss::ObsEpoch& be, int base_index,
                       double age_s, const Eigen::Vector3d& p_a_e, const LeverArm& arm, const Eigen::Matrix3d& C_pos_e,
                       const std::vector<int>& clock_slot_of_system, const std::map<gnss::SatId, double>& code_sigma,
-                      EngineSummary& sum);
+                      EngineSummary& sum, int pos_col = ins::kPos.offset);
 
  private:
   const gnss::NavData* nav_;

@@ -140,6 +140,17 @@ struct EngineOptions {
   double carrier_sigma_zenith_m = 0.003;      ///< one receiver's phase σ at zenith, C/N0 ≥ cn0_ref [m] (eq. 1.3)
   double carrier_base_age_sigma_mps = 0.003;  ///< phase noise per second of base age [m/s]
   int ambiguity_slots = 12;               ///< satellites with phase at once (kMaxErrorDim bounds the total)
+  /// Antenna states (docs/carrier.md §10): the antenna's own position and velocity error (ECEF, white-acceleration
+  /// dynamics), tied to the foot by the non-rigid arm (antenna_sigma_*) and the stride-average velocity
+  /// (antenna_stride_velocity_sigma_*) at every rover epoch; the code, Doppler and phase rows measure the antenna
+  /// states instead of the foot through the arm. On with `carrier` (the phase needs an antenna that moves smoothly).
+  bool antenna_state = false;
+  double antenna_accel_sigma_horizontal_mps2 = 1.0;  ///< white acceleration of the antenna, √PSD [m/s²/√Hz]
+  double antenna_accel_sigma_vertical_mps2 = 0.5;
+  /// The tie at mid-stance (docs/carrier.md eq. 10.2): the body, and the antenna, pass over the stance foot there, so
+  /// the arm's walking variation is at its smallest [m] (the inverted-pendulum gait; not tuned).
+  double antenna_stance_sigma_horizontal_m = 0.1;
+  double antenna_stance_sigma_vertical_m = 0.1;
   gnss::DopplerSlipOptions carrier_slip;
   AmbiguityOptions ambiguity;
   // Output.
@@ -192,6 +203,12 @@ struct EpochOutput {
   int solution_status = 0;
   int n_fixed_ambiguities = 0;
   double ar_ratio = 0.0;
+  /// With EngineOptions::antenna_state: the antenna's position [m] ECEF, velocity [m/s] ECEF and their covariances
+  /// NED (antenna.csv, docs/carrier.md §10).
+  bool has_antenna = false;
+  Eigen::Vector3d ant_p_e = Eigen::Vector3d::Zero();
+  Eigen::Vector3d ant_v_e = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d cov_ant_p_n = Eigen::Matrix3d::Zero();
 };
 
 /// The IMU errors the forward filter ended with (body axes), their σ, and for the scale factors the total the
@@ -230,6 +247,8 @@ struct EngineSummary {
   struct Carrier {
     long epochs_with_phase = 0, fix_attempts = 0, fixes_rejected_by_validation = 0, wrong_fix_detections = 0;
     long holds = 0, no_free_slot = 0;
+    /// Antenna states (docs/carrier.md §10): ties applied, and ties left out by the consistency gate (eq. 10.4).
+    long antenna_ties = 0, antenna_ties_rejected = 0;
     std::array<long, static_cast<int>(gnss::SlipReason::kCount)> slips{};
     std::map<std::string, long> not_fixed;
   } carrier;

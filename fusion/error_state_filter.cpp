@@ -88,6 +88,14 @@ ErrorStateFilter::ErrorStateFilter(const EngineOptions& o, int n_clocks) : o_(o)
       amb_block_ = *b;
       amb_value_.assign(o.ambiguity_slots, 0.0);
     }
+    if (o.antenna_state) {
+      auto b = layout_.add("antenna", 6);
+      if (!b) {
+        problem_ = b.error().message;
+        return;
+      }
+      ant_block_ = *b;
+    }
   }
   // The g-sensitive gyro error (docs/error_state.md §5) when the spec gives its σ; after the GNSS blocks, so that
   // the errors-in-variables footprints of tc (kept on the leading INS block) do not carry it.
@@ -116,6 +124,27 @@ ErrorStateFilter::ErrorStateFilter(const EngineOptions& o, int n_clocks) : o_(o)
   }
   n_dense_rows_ins_ = n_dense_rows_;
   for (const auto& b : clock_blocks_) dense_rows_[n_dense_rows_++] = b.offset;
+  for (int i = 0; i < (ant_block_.dim > 0 ? 3 : 0); ++i) dense_rows_[n_dense_rows_++] = ant_block_.offset + i;
+}
+
+void ErrorStateFilter::init_antenna(const Vector3d& p_e, const Vector3d& v_e, const Eigen::Matrix3d& cov_p_e,
+                                    const Eigen::Matrix3d& cov_v_e) {
+  if (ant_block_.dim == 0) return;
+  const int a = ant_block_.offset;
+  for (int i = 0; i < 6; ++i) restart_variable(a + i, 1.0);  // independent of everything (also in the smoother)
+  auto set = [&](ErrorMatrix& P) {
+    P.block<3, 3>(a, a) = cov_p_e;
+    P.block<3, 3>(a + 3, a + 3) = cov_v_e;
+  };
+  set(P_);
+  if (shadow_) set(Po_);
+  ant_p_e_ = p_e;
+  ant_v_e_ = v_e;
+  const Geodetic llh = geodetic_from_ecef(p_e);
+  const Eigen::Matrix3d Ren = R_e_n(llh.lat, llh.lon);
+  const double qh = o_.antenna_accel_sigma_horizontal_mps2 * o_.antenna_accel_sigma_horizontal_mps2;
+  const double qv = o_.antenna_accel_sigma_vertical_mps2 * o_.antenna_accel_sigma_vertical_mps2;
+  ant_q_e_ = Ren * Vector3d(qh, qh, qv).asDiagonal() * Ren.transpose();
 }
 
 void ErrorStateFilter::init(const ins::NavState& nav, const ins::ImuErrors& imu, double sigma_yaw_rad) {
@@ -134,6 +163,11 @@ void ErrorStateFilter::init(const ins::NavState& nav, const ins::ImuErrors& imu,
   for (int i = 0; i < amb_block_.dim; ++i) {  // no satellite yet (also at a re-initialization)
     P_(amb_block_.offset + i, amb_block_.offset + i) = 1.0;
     amb_value_[i] = 0.0;
+  }
+  if (ant_block_.dim > 0) {  // until init_antenna: at the IMU, 100 m (also at a re-initialization)
+    ant_p_e_ = nav.p_eb_e;
+    ant_v_e_.setZero();
+    for (int i = 0; i < 6; ++i) P_(ant_block_.offset + i, ant_block_.offset + i) = 1e4;
   }
   for (int i = 0; i < mp_block_.dim; ++i) {  // unit-variance GM, no satellite yet (also at a re-initialization)
     P_(mp_block_.offset + i, mp_block_.offset + i) = 1.0;
@@ -209,6 +243,16 @@ void ErrorStateFilter::predict(const ins::ImuIncrement& inc) {
       mp_value_[i] *= e;
     }
   }
+  // Antenna (docs/carrier.md eq. 10.1): p_a += v_a dt, white acceleration of PSD Q_a.
+  if (ant_block_.dim > 0) {
+    const int a = ant_block_.offset, v = a + 3;
+    for (int i = 0; i < 3; ++i) m.Phi(a + i, v + i) = dt;
+    m.Qd.block<3, 3>(a, a) += ant_q_e_ * (dt * dt * dt / 3.0);
+    m.Qd.block<3, 3>(a, v) += ant_q_e_ * (dt * dt / 2.0);
+    m.Qd.block<3, 3>(v, a) += ant_q_e_ * (dt * dt / 2.0);
+    m.Qd.block<3, 3>(v, v) += ant_q_e_ * dt;
+    ant_p_e_ += ant_v_e_ * dt;
+  }
   Phi_rows_.assign(m.Phi, dense_rows_, n_dense_rows_);
   // Smoother: the cross-covariance of the error at the last output epoch with the current error, Γ ← Γ Φᵀ
   // (docs/fusion.md eq. 12.15).
@@ -229,6 +273,10 @@ void ErrorStateFilter::apply(const ErrorVector& dx) {
   if (o_.mode == Mode::kTightlyCoupled) drift_mps_ += dx(drift_block_.offset);
   for (int i = 0; i < mp_block_.dim; ++i) mp_value_[i] += dx(mp_block_.offset + i);
   for (int i = 0; i < amb_block_.dim; ++i) amb_value_[i] += dx(amb_block_.offset + i);
+  if (ant_block_.dim > 0) {
+    ant_p_e_ += dx.segment<3>(ant_block_.offset);
+    ant_v_e_ += dx.segment<3>(ant_block_.offset + 3);
+  }
 }
 
 int ErrorStateFilter::multipath_slot(const gnss::SatId& sat, int64_t t_ns, bool& reset) {

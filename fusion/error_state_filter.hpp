@@ -115,6 +115,16 @@ class ErrorStateFilter {
   int ambiguity_offset() const { return amb_block_.offset; }
   int ambiguity_slots() const { return amb_block_.dim; }
   double& ambiguity_value(int slot) { return amb_value_[slot]; }
+  /// Antenna states (EngineOptions::antenna_state, docs/carrier.md §10): first state of the antenna position error
+  /// (its velocity error follows at +3), −1 without; the nominal antenna position [m] and velocity [m/s], ECEF.
+  bool has_antenna() const { return ant_block_.dim > 0; }
+  int antenna_offset() const { return ant_block_.dim > 0 ? ant_block_.offset : -1; }
+  const Eigen::Vector3d& antenna_p_e() const { return ant_p_e_; }
+  const Eigen::Vector3d& antenna_v_e() const { return ant_v_e_; }
+  /// Start the antenna states at p_e, v_e with the given covariances (ECEF), independent of the rest, and take the
+  /// white-acceleration PSD in the local level frame of p_e (eq. 10.1).
+  void init_antenna(const Eigen::Vector3d& p_e, const Eigen::Vector3d& v_e, const Eigen::Matrix3d& cov_p_e,
+                    const Eigen::Matrix3d& cov_v_e);
 
   // P <- J P J^T with J = I except the (velocity, attitude) block = A (docs/fusion.md eq. 5.9).
   void reexpress_velocity_attitude(const Eigen::Matrix3d& A);
@@ -183,6 +193,9 @@ class ErrorStateFilter {
   std::vector<double> mp_value_;
   ins::Block amb_block_{0, 0};    // carrier-phase ambiguity slots (random constants: Φ = 1, no process noise)
   std::vector<double> amb_value_;
+  ins::Block ant_block_{0, 0};  // antenna position and velocity errors (6), ECEF
+  Eigen::Vector3d ant_p_e_ = Eigen::Vector3d::Zero(), ant_v_e_ = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d ant_q_e_ = Eigen::Matrix3d::Zero();  // white-acceleration PSD [m²/s³], ECEF
   std::vector<gnss::SatId> mp_sat_;
   std::vector<int64_t> mp_last_ns_;
   RowTransition<ins::kMaxErrorDim> Phi_rows_;  // Φ of the current step by its row structure

@@ -3,12 +3,14 @@
 #include "fusion/forward_runner.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
 
 #include "core/geodesy.hpp"
 #include "core/rotation.hpp"
+#include "fusion/antenna_state.hpp"
 #include "fusion/fault_detection.hpp"
 #include "fusion/rts.hpp"
 #include "ins/mechanization.hpp"
@@ -24,7 +26,8 @@ constexpr double kInsFilterSigmaYawRad = 0.1 * 3.14159265358979323846 / 180.0;
 // Re-initialization from a GNSS epoch solution after divergence (tc mode): at most this many per run; the attitude is
 // the last healthy stance attitude, its heading may be off (wide σ), the walker's velocity is unknown.
 constexpr int kMaxReinitializations = 5;
-constexpr double kStatusMaxAge_s = 1.5;  // a GNSS epoch's carrier status holds for this long (docs/carrier.md §6)
+constexpr double kStatusMaxAge_s = 1.5;
+constexpr double kAntennaTieMaxGapS = 2.0;  // antenna states: a GNSS epoch ties the antenna when no stance did for this long  // a GNSS epoch's carrier status holds for this long (docs/carrier.md §6)
 constexpr double kReinitSigmaYawRad = 30.0 * 3.14159265358979323846 / 180.0;
 constexpr double kReinitSigmaVelMps = 2.0;
 constexpr double kReinitSigmaPosM = 10.0;  // an epoch least-squares position (single epoch, possibly undifferenced)
@@ -75,6 +78,7 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
   }
   f.init(nav0, imu0, filter_sigma_yaw_rad);
   stride_.reset();
+  init_antenna_from_foot(f, o_, stride_);  // antenna states (docs/carrier.md §10): at the foot + arm
   EngineSummary& sum = result.summary;
   if (o_.mode == Mode::kTightlyCoupled) {
     // The outcomes every epoch can have exist from the start (0 until they happen): a first rejection later in
@@ -95,6 +99,7 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
   RtsSegment segment;
   RtsStore segments(n_state);
   std::vector<ins::InsState> nominal_at_output;
+  std::vector<std::array<Vector3d, 2>> antenna_at_output;  // antenna states: nominal position, velocity
   // Storage sized once from the data span (no reallocation on the per-epoch path; docs/performance.md).
   const double span_s = std::max(0.0, in_.imu->back().t - nav0.t);
   const size_t expected_outputs = static_cast<size_t>(span_s * o_.output_rate_hz) + 2;
@@ -102,6 +107,7 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
   if (smooth) {
     segments.reserve(expected_outputs);
     nominal_at_output.reserve(expected_outputs);
+    if (f.has_antenna()) antenna_at_output.reserve(expected_outputs);
   }
   if (o_.record_gnss_rows && in_.rover) result.gnss_rows.reserve(result.gnss_rows.size() + in_.rover->size() * gnss_.row_capacity());
   bool segment_open = false;
@@ -138,6 +144,12 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
   gnss_.restart(/*clear_fault_history=*/false);
 
   int64_t next_nhc_ns = 0;
+  // Antenna states (docs/carrier.md §10): the tie at mid-stance, and at a GNSS epoch when no stance tied the antenna
+  // for kAntennaTieMaxGapS (a hand-held IMU, a long swing).
+  const std::vector<size_t> tie_samples =
+      f.has_antenna() ? antenna_tie_samples(decisions_, samples) : std::vector<size_t>{};
+  size_t next_tie = static_cast<size_t>(std::lower_bound(tie_samples.begin(), tie_samples.end(), start) - tie_samples.begin());
+  int64_t last_tie_ns = std::numeric_limits<int64_t>::min() / 2;
   auto on_increment = [&](const ins::ImuIncrement& inc) {
     if (failed || waiting) return;
     const Vector3d p_before = f.x().nav.p_eb_e;
@@ -155,8 +167,15 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
     if (steps) {
       if (auto m = steps->push(f.x().nav, inc.dt_s, stance)) stance_.step_velocity_update(f, *m, sum);
     }
+    if (next_tie < tie_samples.size() && tie_samples[next_tie] <= sample_index) {
+      while (next_tie < tie_samples.size() && tie_samples[next_tie] <= sample_index) ++next_tie;
+      if (antenna_tie_update(f, o_, stride_, /*mid_stance=*/true, sum)) last_tie_ns = inc.t1.ns();
+    }
     // GNSS epochs up to the interval end.
     while (po.gnss && o_.mode == Mode::kTightlyCoupled && in_.rover && gi < in_.rover->size() && (*in_.rover)[gi].time <= inc.t1) {
+      if (f.has_antenna() && inc.t1.ns() - last_tie_ns > static_cast<int64_t>(kAntennaTieMaxGapS * 1e9)) {
+        if (antenna_tie_update(f, o_, stride_, /*mid_stance=*/false, sum)) last_tie_ns = inc.t1.ns();
+      }
       gnss_.update(f, gi, inc.t1, stride_, clock_initialized, sum, last_used, last_rejected,
                   o_.record_gnss_rows ? &result.gnss_rows : nullptr);
       ++gi;
@@ -194,6 +213,7 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
     if (output_now) {
       while (next_out_ns <= inc.t1.ns()) next_out_ns += out_period_ns;
       result.epochs.push_back(output(f.x(), f.P(), inc.t1, stance, last_used, last_rejected));
+      if (f.has_antenna()) antenna_output(result.epochs.back(), f.antenna_p_e(), f.antenna_v_e(), f.P(), f.antenna_offset());
       if (o_.carrier) {
         // The status of the last GNSS epoch while it is recent (docs/carrier.md §6), else the INS carries it.
         EpochOutput& e = result.epochs.back();
@@ -213,6 +233,7 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
         f.smoother_restart();
         segment_open = true;
         nominal_at_output.push_back(f.x());
+        if (f.has_antenna()) antenna_at_output.push_back({f.antenna_p_e(), f.antenna_v_e()});
       }
     }
     if (in_.on_step) in_.on_step(inc.t1);
@@ -331,7 +352,8 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
     // The tail: the last output epoch -> the last step (eq. 12.10).
     RtsSegment tail;
     f.smoother_close(tail);
-    const size_t bytes = segments.bytes() + nominal_at_output.size() * sizeof(ins::InsState);
+    const size_t bytes = segments.bytes() + nominal_at_output.size() * sizeof(ins::InsState) +
+                         antenna_at_output.size() * sizeof(antenna_at_output[0]);
     result.smoothed.resize(result.epochs.size());
     bool finite = true;
     size_t bad = 0;
@@ -344,6 +366,11 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
       result.smoothed[k].solution_status = fwd.solution_status;  // smoothed epochs carry the forward status
       result.smoothed[k].n_fixed_ambiguities = fwd.n_fixed_ambiguities;
       result.smoothed[k].ar_ratio = fwd.ar_ratio;
+      if (f.has_antenna()) {
+        const int a = f.antenna_offset();
+        antenna_output(result.smoothed[k], antenna_at_output[k][0] + dx.segment<3>(a),
+                       antenna_at_output[k][1] + dx.segment<3>(a + 3), P, a);
+      }
       if (finite && (!xs.nav.p_eb_e.allFinite() || !P.allFinite())) {
         finite = false;
         bad = k;
@@ -391,11 +418,23 @@ bool ForwardRunner::reinitialize(ErrorStateFilter& f, GpsTime t, bool stance, si
   f.init(nav, last_stance.imu, std::max(o_.initial_sigma_yaw_rad, kReinitSigmaYawRad));
   f.set_block_sigma(ins::kVel, kReinitSigmaVelMps);
   f.set_block_sigma(ins::kPos, std::max(o_.initial_sigma_pos_m, kReinitSigmaPosM));
+  stride_.reset();
+  init_antenna_from_foot(f, o_, stride_);
   ++sum.reinitializations;
   sum.health_events.push_back("re-initialized at " + t.to_string() + " from the GNSS epoch solution of " +
                               pending->t.to_string());
   pending.reset();
   return true;
+}
+
+void ForwardRunner::antenna_output(EpochOutput& e, const Vector3d& p_e, const Vector3d& v_e, const ErrorMatrix& P,
+                                   int offset) {
+  e.has_antenna = true;
+  e.ant_p_e = p_e;
+  e.ant_v_e = v_e;
+  const Geodetic llh = geodetic_from_ecef(p_e);
+  const Eigen::Matrix3d Rne = R_e_n(llh.lat, llh.lon).transpose();
+  e.cov_ant_p_n = Rne * P.block<3, 3>(offset, offset) * Rne.transpose();
 }
 
 EpochOutput ForwardRunner::output(const ins::InsState& x, const ErrorMatrix& P, GpsTime t, bool zupt, int used, int rejected) const {

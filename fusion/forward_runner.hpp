@@ -79,6 +79,10 @@ class ForwardRunner {
                     std::optional<PendingFix>& pending, EngineSummary& sum);
   // One output epoch from a nominal navigation state and the covariance of its error (forward or smoothed).
   EpochOutput output(const ins::InsState& x, const ErrorMatrix& P, GpsTime t, bool zupt, int used, int rejected) const;
+  // The antenna states of an output epoch (docs/carrier.md §10): nominal (or smoothed) position and velocity, ECEF,
+  // and the position covariance of the error block at `offset`.
+  static void antenna_output(EpochOutput& e, const Eigen::Vector3d& p_e, const Eigen::Vector3d& v_e, const ErrorMatrix& P,
+                             int offset);
 
   const EngineInputs& in_;
   const EngineOptions& o_;

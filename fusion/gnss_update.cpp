@@ -7,6 +7,7 @@
 
 #include "core/geodesy.hpp"
 #include "core/rotation.hpp"
+#include "fusion/antenna_state.hpp"
 #include "fusion/lever_arm.hpp"
 #include "gnss/ephemeris.hpp"
 #include "gnss/least_squares.hpp"
@@ -89,6 +90,7 @@ void GnssEpochUpdater::update(ErrorStateFilter& f, size_t gi, GpsTime t_proc, co
                               bool& clock_initialized, EngineSummary& sum, int& used_out, int& rejected_out,
                               std::vector<GnssRowRecord>* records) {
   re_ = (*in_.rover)[gi];  // copy into a reused buffer (no allocation once its capacity suffices)
+  const bool ant = f.has_antenna();  // antenna states (docs/carrier.md §10)
   gnss::ObsEpoch& re = re_;
   if (in_.gnss_mask) {
     const size_t before = re.sats.size();
@@ -127,12 +129,13 @@ void GnssEpochUpdater::update(ErrorStateFilter& f, size_t gi, GpsTime t_proc, co
   const Geodetic llh_imu = geodetic_from_ecef(p_imu);
   const LeverArm arm = lever_arm_e(o_.lever_arm_n_m, o_.lever_arm_heading_m, R_e_n(llh_imu.lat, llh_imu.lon),
                                    f.x().nav.R_e_b());
-  const Vector3d p_a = p_imu + arm.arm_e;
   // Antenna (body) velocity: the foot's stride-average velocity (eq. 13.1) or, with the kFoot model or before a
-  // cycle of history exists, the foot's own velocity.
+  // cycle of history exists, the foot's own velocity. With antenna states: the antenna's own (eq. 10.3).
   std::optional<Vector3d> v_stride;
-  if (o_.antenna_velocity_model == AntennaVelocityModel::kStrideAverage) v_stride = stride.velocity_e();
-  const Vector3d v_a = v_stride ? *v_stride : f.x().nav.v_eb_e;
+  if (o_.antenna_velocity_model == AntennaVelocityModel::kStrideAverage && !ant) v_stride = stride.velocity_e();
+  const Vector3d v_a = ant ? f.antenna_v_e() : v_stride ? *v_stride : f.x().nav.v_eb_e;
+  const Vector3d p_a = ant ? Vector3d(f.antenna_p_e() - v_a * lag_s) : Vector3d(p_imu + arm.arm_e);
+  const int pos_col = ant ? f.antenna_offset() : ins::kPos.offset;
   const Geodetic llh = geodetic_from_ecef(p_a);
   std::vector<GnssRow>& rows = rows_;
   rows.clear();
@@ -190,8 +193,8 @@ void GnssEpochUpdater::update(ErrorStateFilter& f, size_t gi, GpsTime t_proc, co
     rc.residual = code.residual;
     rc.sigma = sigma_c;
     rc.h = ins::ErrorRowVector::Zero(n);
-    rc.h.segment<3>(ins::kPos.offset) = code.J_p;
-    rc.h.segment<3>(ins::kAtt.offset) = code.J_p * arm.d_arm_d_phi_e;  // eq. 14.2 (zero without a heading part)
+    rc.h.segment<3>(pos_col) = code.J_p;
+    if (!ant) rc.h.segment<3>(ins::kAtt.offset) = code.J_p * arm.d_arm_d_phi_e;  // eq. 14.2 (zero without a heading part)
     rc.j_antenna = code.J_p;
     rc.h(f.clock_offset(slot)) = code.J_clock;
     if (f.has_multipath()) {
@@ -221,9 +224,11 @@ void GnssEpochUpdater::update(ErrorStateFilter& f, size_t gi, GpsTime t_proc, co
       rd.residual = rate.residual;
       rd.sigma = sigma_d;
       rd.h = ins::ErrorRowVector::Zero(n);
-      rd.h.segment<3>(ins::kPos.offset) = rate.J_p;
+      rd.h.segment<3>(pos_col) = rate.J_p;
       rd.j_antenna = rate.J_v;
-      if (v_stride) {
+      if (ant) {
+        rd.h.segment<3>(f.antenna_offset() + 3) = rate.J_v;  // eq. 10.3
+      } else if (v_stride) {
         // δv̄ = −[v̄×] φ (eq. 13.2): the heading error rotates the INS stride; the velocity error is not in v̄.
         rd.h.segment<3>(ins::kAtt.offset) = rate.J_v * stride_velocity_attitude_jacobian(*v_stride);
       } else {
@@ -267,7 +272,8 @@ void GnssEpochUpdater::update(ErrorStateFilter& f, size_t gi, GpsTime t_proc, co
   const double svh = v_stride ? o_.antenna_stride_velocity_sigma_horizontal_mps : o_.antenna_velocity_sigma_horizontal_mps;
   const double svv = v_stride ? o_.antenna_stride_velocity_sigma_vertical_mps : o_.antenna_velocity_sigma_vertical_mps;
   const Eigen::Matrix3d C_vel = Ren * Vector3d(svh * svh, svh * svh, svv * svv).asDiagonal() * Ren.transpose();
-  const CommonAntennaNoise noise{C_pos, C_vel};
+  // With antenna states the offset is in the state (eq. 10.3): no common term.
+  const CommonAntennaNoise noise{ant ? Eigen::Matrix3d::Zero() : C_pos, ant ? Eigen::Matrix3d::Zero() : C_vel};
   std::vector<int>& active = active_;
   int rejected_code = 0;
   bool updated = false;
@@ -290,12 +296,18 @@ void GnssEpochUpdater::update(ErrorStateFilter& f, size_t gi, GpsTime t_proc, co
     // moved back to the epoch as above.
     const Vector3d p_imu2 = f.x().nav.p_eb_e - f.x().nav.v_eb_e * lag_s;
     const Geodetic llh2 = geodetic_from_ecef(p_imu2);
-    const LeverArm arm2 = lever_arm_e(o_.lever_arm_n_m, o_.lever_arm_heading_m, R_e_n(llh2.lat, llh2.lon),
-                                      f.x().nav.R_e_b());
+    LeverArm arm2 = lever_arm_e(o_.lever_arm_n_m, o_.lever_arm_heading_m, R_e_n(llh2.lat, llh2.lon),
+                                f.x().nav.R_e_b());
+    Vector3d p_a2 = p_imu2 + arm2.arm_e;
+    if (ant) {  // the antenna states carry the offset (eq. 10.3)
+      p_a2 = f.antenna_p_e() - f.antenna_v_e() * lag_s;
+      arm2 = LeverArm{};
+    }
     std::vector<int> clock_slot_of_system(static_cast<int>(gnss::System::kSbas) + 1, -1);
     for (size_t k = 0; k < o_.systems.size(); ++k) clock_slot_of_system[static_cast<int>(o_.systems[k])] = static_cast<int>(k);
-    last_carrier_ = carrier_->update(f, re, *be, matches_[gi].base_index, std::abs(matches_[gi].age_s), p_imu2 + arm2.arm_e, arm2,
-                                     C_pos, clock_slot_of_system, code_sigma_, sum);
+    last_carrier_ = carrier_->update(f, re, *be, matches_[gi].base_index, std::abs(matches_[gi].age_s), p_a2, arm2,
+                                     ant ? Eigen::Matrix3d::Zero() : C_pos, clock_slot_of_system, code_sigma_, sum,
+                                     pos_col);
     last_carrier_time_ = re.time;
   }
   // Divergence watch: most code rows of a well-observed epoch rejected, epoch after epoch (kImplausibleEpochs).

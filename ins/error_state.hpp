@@ -19,7 +19,7 @@
 namespace pednav::ins {
 
 /// Largest error-state dimension (15 core + scale factors + clocks + ...): the capacity of the matrix types below.
-inline constexpr int kMaxErrorDim = 48;
+inline constexpr int kMaxErrorDim = 64;
 /// Error-state vector and matrix with a compile-time capacity of kMaxErrorDim: sized at run time, stored inline, so
 /// the per-epoch path never allocates on the heap (issue 10; docs/performance.md).
 using ErrorVector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxErrorDim, 1>;

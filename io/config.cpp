@@ -210,6 +210,8 @@ std::string to_yaml(const RunConfig& c) {
     << yaml_number(c.antenna.velocity_sigma_vertical_mps) << YAML::Key << "stride_velocity_sigma_horizontal_mps"
     << YAML::Value << yaml_number(c.antenna.stride_velocity_sigma_horizontal_mps) << YAML::Key
     << "stride_velocity_sigma_vertical_mps" << YAML::Value << yaml_number(c.antenna.stride_velocity_sigma_vertical_mps)
+    << YAML::Key << "stance_sigma_horizontal_m" << YAML::Value << yaml_number(c.antenna.stance_sigma_horizontal_m)
+    << YAML::Key << "stance_sigma_vertical_m" << YAML::Value << yaml_number(c.antenna.stance_sigma_vertical_m)
     << YAML::EndMap;
   {
     const InitialConfig& i = c.initial;

@@ -170,6 +170,9 @@ struct AntennaConfig {
   std::string velocity_model = "stride_average";  ///< stride_average | foot (docs/fusion.md §13)
   double stride_velocity_sigma_horizontal_mps = 0.3;
   double stride_velocity_sigma_vertical_mps = 0.3;
+  /// With antenna states (gnss.carrier: on in tc, docs/carrier.md §10): the foot-to-antenna tie's σ at mid-stance.
+  double stance_sigma_horizontal_m = 0.1;
+  double stance_sigma_vertical_m = 0.1;
 };
 
 /// `clock:` section: differential receiver clock model.

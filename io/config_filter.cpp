@@ -126,6 +126,8 @@ void read_filter_section(YamlMap& top, RunConfig& out) {
     a.choice("velocity_model", c.velocity_model, {"stride_average", "foot"});
     a.number("stride_velocity_sigma_horizontal_mps", c.stride_velocity_sigma_horizontal_mps, false, 1e-3, 100.0);
     a.number("stride_velocity_sigma_vertical_mps", c.stride_velocity_sigma_vertical_mps, false, 1e-3, 100.0);
+    a.number("stance_sigma_horizontal_m", c.stance_sigma_horizontal_m, false, 1e-3, 100.0);
+    a.number("stance_sigma_vertical_m", c.stance_sigma_vertical_m, false, 1e-3, 100.0);
   }
   {
     YamlMap k = top.map("clock");

@@ -129,6 +129,8 @@ static nlohmann::json carrier_json(const fusion::EngineSummary& sum, const std::
     slips[gnss::slip_reason_name(static_cast<gnss::SlipReason>(i))] = k.slips[i];
   }
   c["slips"] = slips;
+  // Antenna states (docs/carrier.md §10): foot-to-antenna ties (position and velocity halves) applied and gated out.
+  c["antenna_ties"] = {{"applied", k.antenna_ties}, {"rejected", k.antenna_ties_rejected}};
   return c;
 }
 
@@ -187,6 +189,8 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
                                                                 : fusion::AntennaVelocityModel::kStrideAverage;
   o.antenna_stride_velocity_sigma_horizontal_mps = c.antenna.stride_velocity_sigma_horizontal_mps;
   o.antenna_stride_velocity_sigma_vertical_mps = c.antenna.stride_velocity_sigma_vertical_mps;
+  o.antenna_stance_sigma_horizontal_m = c.antenna.stance_sigma_horizontal_m;
+  o.antenna_stance_sigma_vertical_m = c.antenna.stance_sigma_vertical_m;
   o.clock_psd_m2_per_s = c.clock.psd_m2_per_s;
   o.drift_psd_m2_per_s3 = c.clock.drift_psd_m2_per_s3;
   o.clock_jump_threshold_m = c.clock.jump_threshold_m;
@@ -203,6 +207,8 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.carrier_sigma_zenith_m = c.gnss.carrier_sigma_zenith_m;
   o.carrier_base_age_sigma_mps = c.gnss.carrier_base_age_sigma_mps;
   o.ambiguity = ambiguity_options(c.gnss);
+  o.antenna_accel_sigma_horizontal_mps2 = c.gnss.rtk_accel_sigma_horizontal_mps2;  // the RTK antenna's (eq. 10.1)
+  o.antenna_accel_sigma_vertical_mps2 = c.gnss.rtk_accel_sigma_vertical_mps2;
   const ImuErrorModelChoice m = imu_error_model_choice(c);
   o.estimate_scale_factors = m.scale_states;
   o.estimate_gyro_scale_factors = m.gyro_scale_states;
@@ -313,8 +319,21 @@ Expected<RunInputs> load_run_inputs(const RunConfig& c, const ImuLog* given_imu)
     const std::string why_not = carrier_unavailable(c.gnss, *d.rover, d.base ? &*d.base : nullptr);
     if (!why_not.empty()) return make_error(c.source_file + ": gnss.carrier: on, but " + why_not);
     d.options.carrier = true;
+    d.options.antenna_state = true;  // the phase measures an antenna that moves smoothly (docs/carrier.md §10)
   }
   return d;
+}
+
+SolutionRow antenna_row(const fusion::EpochOutput& e) {
+  SolutionRow r = solution_row(e);
+  r.p_e = e.ant_p_e;
+  const Geodetic llh = geodetic_from_ecef(e.ant_p_e);
+  r.v_n = R_e_n(llh.lat, llh.lon).transpose() * e.ant_v_e;
+  r.rpy_deg.reset();
+  r.sd_yaw_deg.reset();
+  r.zupt.reset();
+  r.cov_p_n = e.cov_ant_p_n;
+  return r;
 }
 
 Expected<RunConfig> tc_config(const RunConfig& c, const std::string& command) {
@@ -363,6 +382,12 @@ Expected<RunOutputs> compute_run(const RunConfig& c, const RunInputs& data, std:
   std::vector<SolutionRow>& smoothed_rows = outputs.smoothed_rows;
   smoothed_rows.reserve(res->smoothed.size());
   for (const auto& e : res->smoothed) smoothed_rows.push_back(solution_row(e));
+  for (const auto& e : res->epochs) {
+    if (e.has_antenna) outputs.antenna_rows.push_back(antenna_row(e));
+  }
+  for (const auto& e : res->smoothed) {
+    if (e.has_antenna) outputs.antenna_smoothed_rows.push_back(antenna_row(e));
+  }
   if (!sum.smoother_message.empty()) spdlog::warn("{} (only the forward solution is written)", sum.smoother_message);
   for (const auto& note : sum.saturation_notes) spdlog::warn("{}: {}", c.imu.file, note);
   if (sum.saturated_runs > 0) {
@@ -370,7 +395,7 @@ Expected<RunOutputs> compute_run(const RunConfig& c, const RunInputs& data, std:
                  c.imu.file, sum.saturated_runs, sum.saturated_samples, sum.saturated_runs_reconstructed,
                  sum.saturation_max_added_deg);
   }
-  if (!sum.smoothed) smoothed_rows.clear();
+  if (!sum.smoothed) smoothed_rows.clear(), outputs.antenna_smoothed_rows.clear();
 
   nlohmann::ordered_json& j = outputs.summary;
   j["mode"] = c.mode;
@@ -555,6 +580,20 @@ Expected<void> write_run_outputs(const RunConfig& c, RunOutputs& o, const std::s
     if (auto ok = write_solution_pos((out / "solution_smoothed.pos").string(), o.smoothed_rows,
                                      {"pednav run (" + c.mode + ", RTS smoothed, IMU position)", c.source_file});
         !ok) {
+      return ok.error();
+    }
+  }
+  // The antenna states' own track (docs/carrier.md §10): what a receiver's RTK solution or a GGA log is compared with.
+  if (!o.antenna_rows.empty()) {
+    if (auto ok = write_solution_csv((out / "antenna.csv").string(), o.antenna_rows); !ok) return ok.error();
+    if (auto ok = write_solution_pos((out / "antenna.pos").string(), o.antenna_rows,
+                                     {"pednav run (" + c.mode + ", forward filter, antenna position)", c.source_file});
+        !ok) {
+      return ok.error();
+    }
+  }
+  if (!o.antenna_smoothed_rows.empty()) {
+    if (auto ok = write_solution_csv((out / "antenna_smoothed.csv").string(), o.antenna_smoothed_rows); !ok) {
       return ok.error();
     }
   }

@@ -52,6 +52,9 @@ Expected<RunInputs> load_run_inputs(const io::RunConfig& config, const io::ImuLo
 /// One solution.csv / smoothed.csv row of an output epoch (IMU position, NED velocity, attitude, σ; pos quality 4
 /// with satellites used, else 5).
 io::SolutionRow solution_row(const fusion::EpochOutput& e);
+/// The antenna row of an output epoch with antenna states (docs/carrier.md §10): antenna position, velocity and σ,
+/// the epoch's status; no attitude, no ZUPT flag.
+io::SolutionRow antenna_row(const fusion::EpochOutput& e);
 
 /// The configuration as the tightly coupled filter runs it (issue 49 item 8: every command takes any configuration
 /// that has what it needs): mode tc as it is; another mode (a file written for `pednav gnss`, or an INS/ZUPT one with
@@ -68,6 +71,9 @@ struct RunOutputs {
   fusion::EngineResult result;                 ///< forward and smoothed epochs, w-test records (tc), counts
   std::vector<io::SolutionRow> rows;           ///< solution.csv, solution.pos
   std::vector<io::SolutionRow> smoothed_rows;  ///< smoothed.csv (empty when the smoother did not run)
+  /// With antenna states (gnss.carrier: on; docs/carrier.md §10): antenna.csv / antenna_smoothed.csv (and .pos), the
+  /// antenna's own track; empty otherwise.
+  std::vector<io::SolutionRow> antenna_rows, antenna_smoothed_rows;
   nlohmann::ordered_json summary;              ///< summary.json (wall_s: the computation)
   std::string evaluation_json;                 ///< evaluation.json text (with a reference), else empty
   std::string evaluation_smoothed_json;        ///< evaluation_smoothed.json text (with a reference and the smoother)
