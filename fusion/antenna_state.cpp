@@ -16,14 +16,16 @@ using Eigen::Matrix3d;
 using Eigen::Vector3d;
 
 AntennaTieRows antenna_tie_rows(const Vector3d& p_e, const Vector3d& v_e, const LeverArm& arm,
-                                const std::optional<Vector3d>& v_stride_e, const Vector3d& ant_p_e,
-                                const Vector3d& ant_v_e, const Matrix3d& C_pos_e, const Matrix3d& C_vel_e) {
+                                const Matrix3d& d_arm_d_b_e, const std::optional<Vector3d>& v_stride_e,
+                                const Vector3d& ant_p_e, const Vector3d& ant_v_e, const Matrix3d& C_pos_e,
+                                const Matrix3d& C_vel_e) {
   AntennaTieRows t;
   const Matrix3d I = Matrix3d::Identity();
-  t.residual.head<3>() = -(ant_p_e - p_e - arm.arm_e);
+  t.residual.head<3>() = -((ant_p_e - p_e) - arm.arm_e);
   t.J.block<3, 3>(0, kTieFootPos) = -I;
   t.J.block<3, 3>(0, kTieFootAtt) = -arm.d_arm_d_phi_e;
   t.J.block<3, 3>(0, kTieAntPos) = I;
+  t.J.block<3, 3>(0, kTieArmError) = -d_arm_d_b_e;
   if (v_stride_e) {
     t.residual.tail<3>() = -(ant_v_e - *v_stride_e);
     t.J.block<3, 3>(3, kTieFootAtt) = -stride_velocity_attitude_jacobian(*v_stride_e);  // eq. 13.2
@@ -84,9 +86,16 @@ Matrix3d antenna_velocity_cov_e(const EngineOptions& o, const Vector3d& p_e, boo
                 : level_cov_e(p_e, o.antenna_velocity_sigma_horizontal_mps, o.antenna_velocity_sigma_vertical_mps);
 }
 
+Matrix3d arm_heading_axes_e(const Matrix3d& R_e_n, const Matrix3d& R_e_b) {
+  Matrix3d D;
+  for (int k = 0; k < 3; ++k) D.col(k) = lever_arm_e(Vector3d::Zero(), Vector3d::Unit(k), R_e_n, R_e_b).arm_e;
+  return D;
+}
+
 LeverArm filter_lever_arm(const ErrorStateFilter& f, const EngineOptions& o) {
   const Geodetic llh = geodetic_from_ecef(f.x().nav.p_eb_e);
-  return lever_arm_e(o.lever_arm_n_m, o.lever_arm_heading_m, R_e_n(llh.lat, llh.lon), f.x().nav.R_e_b());
+  const Vector3d arm_h = o.lever_arm_heading_m + (f.has_antenna() ? f.antenna_arm_error_h() : Vector3d::Zero());
+  return lever_arm_e(o.lever_arm_n_m, arm_h, R_e_n(llh.lat, llh.lon), f.x().nav.R_e_b());
 }
 
 void init_antenna_from_foot(ErrorStateFilter& f, const EngineOptions& o, const StrideVelocity& stride) {
@@ -97,7 +106,9 @@ void init_antenna_from_foot(ErrorStateFilter& f, const EngineOptions& o, const S
   const Matrix3d cov_p = f.P().block<3, 3>(ins::kPos.offset, ins::kPos.offset) + antenna_position_cov_e(o, p);
   const Matrix3d cov_v =
       f.P().block<3, 3>(ins::kVel.offset, ins::kVel.offset) + antenna_velocity_cov_e(o, p, vs.has_value());
-  f.init_antenna(p + arm.arm_e, vs.value_or(f.x().nav.v_eb_e), cov_p, cov_v);
+  // The arm's error: what the configured arm's σ (antenna_sigma_*) says about the arm a user measured or took as given.
+  const double sh = o.antenna_sigma_horizontal_m, sv = o.antenna_sigma_vertical_m;
+  f.init_antenna(p + arm.arm_e, vs.value_or(f.x().nav.v_eb_e), cov_p, cov_v, Vector3d(sh * sh, sh * sh, sv * sv).asDiagonal());
 }
 
 bool antenna_tie_update(ErrorStateFilter& f, const EngineOptions& o, const StrideVelocity& stride, bool mid_stance,
@@ -105,9 +116,11 @@ bool antenna_tie_update(ErrorStateFilter& f, const EngineOptions& o, const Strid
   if (!f.has_antenna()) return false;
   const Vector3d& p = f.x().nav.p_eb_e;
   const std::optional<Vector3d> vs = stride.velocity_e();
-  const AntennaTieRows t =
-      antenna_tie_rows(p, f.x().nav.v_eb_e, filter_lever_arm(f, o), vs, f.antenna_p_e(), f.antenna_v_e(),
-                       antenna_position_cov_e(o, p, mid_stance), antenna_velocity_cov_e(o, p, vs.has_value()));
+  const Geodetic llh = geodetic_from_ecef(p);
+  const AntennaTieRows t = antenna_tie_rows(
+      p, f.x().nav.v_eb_e, filter_lever_arm(f, o), arm_heading_axes_e(R_e_n(llh.lat, llh.lon), f.x().nav.R_e_b()), vs,
+      f.antenna_p_e(), f.antenna_v_e(), antenna_position_cov_e(o, p, mid_stance),
+      antenna_velocity_cov_e(o, p, vs.has_value()));
   const int n = f.layout().dim(), a = f.antenna_offset();
   Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor, 6, ins::kMaxErrorDim> H =
       Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor, 6, ins::kMaxErrorDim>::Zero(6, n);
@@ -116,26 +129,25 @@ bool antenna_tie_update(ErrorStateFilter& f, const EngineOptions& o, const Strid
   H.middleCols<3>(ins::kAtt.offset) = t.J.middleCols<3>(kTieFootAtt);
   H.middleCols<3>(a) = t.J.middleCols<3>(kTieAntPos);
   H.middleCols<3>(a + 3) = t.J.middleCols<3>(kTieAntVel);
-  // Eq. 10.4: each half's d² = rᵀ S⁻¹ r against χ²(3).
+  H.middleCols<3>(a + 6) = t.J.middleCols<3>(kTieArmError);
+  // Eq. 10.4: each half's d² = rᵀ S⁻¹ r against χ²(3); beyond it the half's noise is inflated by d²/χ² (the foot
+  // and the antenna disagree beyond both σ's: the tie still holds them together, as loosely as the data say).
   const double gate = gnss::chi_square_quantile(o.fault_probability, 3);
-  bool use[2];
-  int m = 0;
+  Eigen::Matrix<double, 6, 6> R = t.cov_meas;
   for (int half = 0; half < 2; ++half) {
     const auto Hh = H.middleRows<3>(3 * half);
     const Matrix3d S = Hh * f.P() * Hh.transpose() + t.cov_meas.block<3, 3>(3 * half, 3 * half);
     const Vector3d r = t.residual.segment<3>(3 * half);
     const Eigen::LDLT<Matrix3d> ldlt(S);
-    use[half] = ldlt.info() == Eigen::Success && r.dot(ldlt.solve(r)) <= gate;
-    if (use[half]) ++sum.carrier.antenna_ties, m += 3;
-    else ++sum.carrier.antenna_ties_rejected;
+    const double d2 = ldlt.info() == Eigen::Success ? r.dot(ldlt.solve(r)) : 0.0;
+    if (d2 <= gate) {
+      ++sum.carrier.antenna_ties;
+    } else {
+      ++sum.carrier.antenna_ties_inflated;
+      R.block<3, 3>(3 * half, 3 * half) *= d2 / gate;
+    }
   }
-  if (m == 6) return f.update(t.residual, H, t.cov_meas);
-  if (m == 0) return false;
-  const int h = use[0] ? 0 : 1;
-  const Eigen::Matrix<double, 3, 1> r3 = t.residual.segment<3>(3 * h);
-  const Rows3 H3 = H.middleRows<3>(3 * h);
-  const Matrix3d R3 = t.cov_meas.block<3, 3>(3 * h, 3 * h);
-  return f.update(r3, H3, R3);
+  return f.update(t.residual, H, R);
 }
 
 }  // namespace pednav::fusion

@@ -247,8 +247,9 @@ struct EngineSummary {
   struct Carrier {
     long epochs_with_phase = 0, fix_attempts = 0, fixes_rejected_by_validation = 0, wrong_fix_detections = 0;
     long holds = 0, no_free_slot = 0;
-    /// Antenna states (docs/carrier.md §10): ties applied, and ties left out by the consistency gate (eq. 10.4).
-    long antenna_ties = 0, antenna_ties_rejected = 0;
+    /// Antenna states (docs/carrier.md §10): tie halves inside the consistency gate, and beyond it (noise inflated,
+    /// eq. 10.4).
+    long antenna_ties = 0, antenna_ties_inflated = 0;
     std::array<long, static_cast<int>(gnss::SlipReason::kCount)> slips{};
     std::map<std::string, long> not_fixed;
   } carrier;

@@ -89,7 +89,7 @@ ErrorStateFilter::ErrorStateFilter(const EngineOptions& o, int n_clocks) : o_(o)
       amb_value_.assign(o.ambiguity_slots, 0.0);
     }
     if (o.antenna_state) {
-      auto b = layout_.add("antenna", 6);
+      auto b = layout_.add("antenna", 9);
       if (!b) {
         problem_ = b.error().message;
         return;
@@ -128,14 +128,16 @@ ErrorStateFilter::ErrorStateFilter(const EngineOptions& o, int n_clocks) : o_(o)
 }
 
 void ErrorStateFilter::init_antenna(const Vector3d& p_e, const Vector3d& v_e, const Eigen::Matrix3d& cov_p_e,
-                                    const Eigen::Matrix3d& cov_v_e) {
+                                    const Eigen::Matrix3d& cov_v_e, const Eigen::Matrix3d& cov_b_h) {
   if (ant_block_.dim == 0) return;
   const int a = ant_block_.offset;
-  for (int i = 0; i < 6; ++i) restart_variable(a + i, 1.0);  // independent of everything (also in the smoother)
+  for (int i = 0; i < 9; ++i) restart_variable(a + i, 1.0);  // independent of everything (also in the smoother)
   auto set = [&](ErrorMatrix& P) {
     P.block<3, 3>(a, a) = cov_p_e;
     P.block<3, 3>(a + 3, a + 3) = cov_v_e;
+    P.block<3, 3>(a + 6, a + 6) = cov_b_h;
   };
+  ant_b_h_.setZero();
   set(P_);
   if (shadow_) set(Po_);
   ant_p_e_ = p_e;
@@ -167,7 +169,8 @@ void ErrorStateFilter::init(const ins::NavState& nav, const ins::ImuErrors& imu,
   if (ant_block_.dim > 0) {  // until init_antenna: at the IMU, 100 m (also at a re-initialization)
     ant_p_e_ = nav.p_eb_e;
     ant_v_e_.setZero();
-    for (int i = 0; i < 6; ++i) P_(ant_block_.offset + i, ant_block_.offset + i) = 1e4;
+    ant_b_h_.setZero();
+    for (int i = 0; i < 9; ++i) P_(ant_block_.offset + i, ant_block_.offset + i) = 1e4;
   }
   for (int i = 0; i < mp_block_.dim; ++i) {  // unit-variance GM, no satellite yet (also at a re-initialization)
     P_(mp_block_.offset + i, mp_block_.offset + i) = 1.0;
@@ -276,6 +279,7 @@ void ErrorStateFilter::apply(const ErrorVector& dx) {
   if (ant_block_.dim > 0) {
     ant_p_e_ += dx.segment<3>(ant_block_.offset);
     ant_v_e_ += dx.segment<3>(ant_block_.offset + 3);
+    ant_b_h_ += dx.segment<3>(ant_block_.offset + 6);
   }
 }
 

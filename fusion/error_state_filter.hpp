@@ -116,15 +116,18 @@ class ErrorStateFilter {
   int ambiguity_slots() const { return amb_block_.dim; }
   double& ambiguity_value(int slot) { return amb_value_[slot]; }
   /// Antenna states (EngineOptions::antenna_state, docs/carrier.md §10): first state of the antenna position error
-  /// (its velocity error follows at +3), −1 without; the nominal antenna position [m] and velocity [m/s], ECEF.
+  /// (its velocity error follows at +3, the arm's error in the foot's heading frame at +6), −1 without; the nominal
+  /// antenna position [m] and velocity [m/s], ECEF, and the arm's error [m] (forward, right, down).
   bool has_antenna() const { return ant_block_.dim > 0; }
   int antenna_offset() const { return ant_block_.dim > 0 ? ant_block_.offset : -1; }
   const Eigen::Vector3d& antenna_p_e() const { return ant_p_e_; }
   const Eigen::Vector3d& antenna_v_e() const { return ant_v_e_; }
+  const Eigen::Vector3d& antenna_arm_error_h() const { return ant_b_h_; }
   /// Start the antenna states at p_e, v_e with the given covariances (ECEF), independent of the rest, and take the
-  /// white-acceleration PSD in the local level frame of p_e (eq. 10.1).
+  /// white-acceleration PSD in the local level frame of p_e (eq. 10.1). The arm's error: a random constant, started at
+  /// zero with covariance cov_b_h unless keep_arm_error (a re-initialization keeps what the run learnt).
   void init_antenna(const Eigen::Vector3d& p_e, const Eigen::Vector3d& v_e, const Eigen::Matrix3d& cov_p_e,
-                    const Eigen::Matrix3d& cov_v_e);
+                    const Eigen::Matrix3d& cov_v_e, const Eigen::Matrix3d& cov_b_h);
 
   // P <- J P J^T with J = I except the (velocity, attitude) block = A (docs/fusion.md eq. 5.9).
   void reexpress_velocity_attitude(const Eigen::Matrix3d& A);
@@ -193,8 +196,9 @@ class ErrorStateFilter {
   std::vector<double> mp_value_;
   ins::Block amb_block_{0, 0};    // carrier-phase ambiguity slots (random constants: Φ = 1, no process noise)
   std::vector<double> amb_value_;
-  ins::Block ant_block_{0, 0};  // antenna position and velocity errors (6), ECEF
+  ins::Block ant_block_{0, 0};  // antenna position and velocity errors (ECEF) and the arm's error (heading frame): 9
   Eigen::Vector3d ant_p_e_ = Eigen::Vector3d::Zero(), ant_v_e_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d ant_b_h_ = Eigen::Vector3d::Zero();  // the arm's error, heading frame (random constant)
   Eigen::Matrix3d ant_q_e_ = Eigen::Matrix3d::Zero();  // white-acceleration PSD [m²/s³], ECEF
   std::vector<gnss::SatId> mp_sat_;
   std::vector<int64_t> mp_last_ns_;

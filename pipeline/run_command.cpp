@@ -129,8 +129,9 @@ static nlohmann::json carrier_json(const fusion::EngineSummary& sum, const std::
     slips[gnss::slip_reason_name(static_cast<gnss::SlipReason>(i))] = k.slips[i];
   }
   c["slips"] = slips;
-  // Antenna states (docs/carrier.md §10): foot-to-antenna ties (position and velocity halves) applied and gated out.
-  c["antenna_ties"] = {{"applied", k.antenna_ties}, {"rejected", k.antenna_ties_rejected}};
+  // Antenna states (docs/carrier.md §10): foot-to-antenna ties (position and velocity halves) inside the χ² gate, and
+  // beyond it (applied with their noise inflated, eq. 10.4).
+  c["antenna_ties"] = {{"consistent", k.antenna_ties}, {"inflated", k.antenna_ties_inflated}};
   return c;
 }
 

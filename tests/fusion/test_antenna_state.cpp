@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // The antenna states of the tight coupling with carrier (fusion/antenna_state.*, docs/carrier.md §10): the tie's
 // Jacobian (eq. 10.2) against central differences through the error-state boxplus (p + δp, v + δv, exp([φ×]) R,
-// antenna p_a + δp_a, v_a + δv_a) with and without a stride velocity, the samples the tie is applied at (mid-stance,
+// antenna p_a + δp_a, v_a + δv_a, arm error b + δb) with and without a stride velocity, the samples the tie is applied at (mid-stance,
 // once per second while standing), the white-acceleration prediction of the antenna block (eq. 10.1), and the
-// consistency gate (eq. 10.4) that leaves a tie out when the foot and the antenna disagree beyond both σ's.
+// consistency gate (eq. 10.4) that inflates a tie's noise when the foot and the antenna disagree beyond both σ's.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -37,11 +37,13 @@ TEST(AntennaTie, JacobianMatchesNumericalDifferentiation) {
                                 so3_exp(Eigen::Vector3d(rpy.x(), 0, 0));
       const std::optional<Eigen::Vector3d> vs =
           with_stride ? std::optional<Eigen::Vector3d>(Ren * Eigen::Vector3d(1.1, 0.6, 0.01)) : std::nullopt;
-      const AntennaTieRows t = antenna_tie_rows(p_e, v_e, lever_arm_e(arm_n, arm_h, Ren, R), vs, ant_p, ant_v, C, C);
+      const Eigen::Vector3d b(0.05, -0.03, 0.2);  // the arm's error estimate (heading frame)
+      const AntennaTieRows t = antenna_tie_rows(p_e, v_e, lever_arm_e(arm_n, arm_h + b, Ren, R),
+                                                arm_heading_axes_e(Ren, R), vs, ant_p, ant_v, C, C);
       // h(x) with the error applied: the stride velocity rotates with the attitude error (docs/fusion.md eq. 13.2).
       auto h = [&](const Eigen::VectorXd& dx) -> Eigen::VectorXd {
         const Eigen::Matrix3d Rt = so3_exp(dx.segment<3>(kTieFootAtt)) * R;
-        const LeverArm arm = lever_arm_e(arm_n, arm_h, Ren, Rt);
+        const LeverArm arm = lever_arm_e(arm_n, arm_h + b + dx.segment<3>(kTieArmError), Ren, Rt);
         Eigen::VectorXd out(6);
         // the antenna-minus-foot difference first: differences of 6e6-m ECEF coordinates would cost the step's digits
         out.head<3>() = (ant_p - p_e) + dx.segment<3>(kTieAntPos) - dx.segment<3>(kTieFootPos) - arm.arm_e;
@@ -50,9 +52,9 @@ TEST(AntennaTie, JacobianMatchesNumericalDifferentiation) {
         out.tail<3>() = (ant_v + dx.segment<3>(kTieAntVel)) - v_ref;
         return out;
       };
-      const Eigen::MatrixXd J = test::numerical_jacobian(h, Eigen::VectorXd::Zero(15), kNumDiffStep);
+      const Eigen::MatrixXd J = test::numerical_jacobian(h, Eigen::VectorXd::Zero(18), kNumDiffStep);
       EXPECT_LT((J - t.J).cwiseAbs().maxCoeff(), kJacobianTol) << "num\n" << J << "\nana\n" << t.J;
-      const Eigen::VectorXd h0 = h(Eigen::VectorXd::Zero(15));
+      const Eigen::VectorXd h0 = h(Eigen::VectorXd::Zero(18));
       EXPECT_LT((t.residual + h0).cwiseAbs().maxCoeff(), 1e-9);
       EXPECT_TRUE((t.cov_meas.topLeftCorner<3, 3>() - C).isZero());
       EXPECT_TRUE((t.cov_meas.block<3, 3>(0, 3)).isZero());
@@ -105,7 +107,8 @@ TEST(AntennaState, WhiteAccelerationPrediction) {
   const Eigen::Vector3d p_e = ecef_from_geodetic(Geodetic{0.9, -0.2, 30.0});
   f.init(level_nav(p_e), ins::ImuErrors{}, 0.1);
   const Eigen::Vector3d v_a(0.5, -1.0, 0.25);
-  f.init_antenna(p_e, v_a, Eigen::Matrix3d::Identity() * 1e-4, Eigen::Matrix3d::Identity() * 1e-6);
+  f.init_antenna(p_e, v_a, Eigen::Matrix3d::Identity() * 1e-4, Eigen::Matrix3d::Identity() * 1e-6,
+                 Eigen::Matrix3d::Identity() * 0.01);
   const int a = f.antenna_offset();
   // 1 s at 20 Hz of a foot at rest.
   const Eigen::Vector3d g_b = f.x().nav.R_e_b().transpose() * (-ins::gravity_ecef(p_e));
@@ -131,9 +134,10 @@ TEST(AntennaState, WhiteAccelerationPrediction) {
   EXPECT_NEAR(Pv(1, 1), 1e-6 + 1.0, 1e-9);
   EXPECT_NEAR(Pv(2, 2), 1e-6 + 0.25, 1e-9);
   EXPECT_NEAR(f.P()(a, ins::kPos.offset), 0.0, 1e-12);  // independent of the foot until a tie
+  EXPECT_NEAR(f.P()(a + 6, a + 6), 0.01, 1e-12);         // the arm's error: a random constant
 }
 
-TEST(AntennaState, TieGateLeavesOutAnAntennaFarFromTheFoot) {
+TEST(AntennaState, TieGateInflatesTheNoiseOfAnAntennaFarFromTheFoot) {
   const EngineOptions o = antenna_options();
   const Eigen::Vector3d p_e = ecef_from_geodetic(Geodetic{0.9, -0.2, 30.0});
   for (const double offset_m : {0.05, 3.0}) {
@@ -144,19 +148,21 @@ TEST(AntennaState, TieGateLeavesOutAnAntennaFarFromTheFoot) {
     const Eigen::Matrix3d Ren = R_e_n(0.9, -0.2);
     // The antenna held by the phase to 1 cm, offset_m north of foot + arm.
     f.init_antenna(p_e + arm.arm_e + Ren * Eigen::Vector3d(offset_m, 0, 0), Eigen::Vector3d::Zero(),
-                   Eigen::Matrix3d::Identity() * 1e-4, Eigen::Matrix3d::Identity() * 1e-4);
+                   Eigen::Matrix3d::Identity() * 1e-4, Eigen::Matrix3d::Identity() * 1e-4,
+                   Eigen::Matrix3d::Identity() * 1e-4);
     EngineSummary sum;
     StrideVelocity stride;
     const Eigen::Vector3d before = f.antenna_p_e();
     antenna_tie_update(f, o, stride, /*mid_stance=*/true, sum);
     if (offset_m < 1.0) {
-      EXPECT_EQ(sum.carrier.antenna_ties, 2);  // position and velocity halves applied
-      EXPECT_EQ(sum.carrier.antenna_ties_rejected, 0);
+      EXPECT_EQ(sum.carrier.antenna_ties, 2);  // position and velocity halves inside the gate
+      EXPECT_EQ(sum.carrier.antenna_ties_inflated, 0);
     } else {
-      // 3 m against σ = √(0.01² + 0.01² + 0.1²) per axis: d² ≈ 890 > χ²(3, 0.999) = 16.3.
-      EXPECT_EQ(sum.carrier.antenna_ties, 1);  // the velocity half only
-      EXPECT_EQ(sum.carrier.antenna_ties_rejected, 1);
-      EXPECT_LT((f.antenna_p_e() - before).norm(), 1e-3);  // the antenna stays where the phase holds it
+      // 3 m against σ = √(0.01² + 0.01² + 0.01² + 0.1²) per axis: d² ≈ 870 > χ²(3, 0.999) = 16.3.
+      EXPECT_EQ(sum.carrier.antenna_ties, 1);  // the velocity half
+      EXPECT_EQ(sum.carrier.antenna_ties_inflated, 1);
+      // The position half's noise ×d²/χ² ≈ 53: the antenna moves ≈ 0.5 mm (at the nominal σ it would move 3 cm).
+      EXPECT_LT((f.antenna_p_e() - before).norm(), 1e-3);
     }
   }
 }
