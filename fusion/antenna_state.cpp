@@ -71,7 +71,7 @@ std::vector<size_t> antenna_tie_samples(const std::vector<ins::ZuptDecision>& de
       for (size_t k = i; k < j && imu[j - 1].t - imu[k].t >= 0.5; ++k) {
         if (imu[k].t - imu[i].t >= next_s) {
           out.push_back(k);
-          next_s += 1.0;
+          next_s += kStandingTieSpacingS;
         }
       }
     }

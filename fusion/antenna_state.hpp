@@ -67,8 +67,12 @@ void init_antenna_from_foot(ErrorStateFilter& f, const EngineOptions& o, const S
 bool antenna_tie_update(ErrorStateFilter& f, const EngineOptions& o, const StrideVelocity& stride, bool mid_stance,
                         EngineSummary& sum);
 
+/// Spacing of the ties while the walker stands [s]: a standing body sways slowly, so ties once per second would count
+/// one offset many times as if each were new (a static antenna over-confident to centimetres, docs/carrier.md §10).
+inline constexpr double kStandingTieSpacingS = 10.0;
+
 /// The samples at which the tie is applied (ascending): the middle of every stance shorter than 2 s, and in a longer
-/// stance (standing) its first sample + 0.5 s and then one per second until 0.5 s before its end.
+/// stance (standing) its first sample + 0.5 s and then one every kStandingTieSpacingS until 0.5 s before its end.
 std::vector<size_t> antenna_tie_samples(const std::vector<ins::ZuptDecision>& decisions,
                                         const std::vector<ins::ImuSample>& imu);
 

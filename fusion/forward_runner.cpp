@@ -27,7 +27,8 @@ constexpr double kInsFilterSigmaYawRad = 0.1 * 3.14159265358979323846 / 180.0;
 // the last healthy stance attitude, its heading may be off (wide σ), the walker's velocity is unknown.
 constexpr int kMaxReinitializations = 5;
 constexpr double kStatusMaxAge_s = 1.5;
-constexpr double kAntennaTieMaxGapS = 2.0;  // antenna states: a GNSS epoch ties the antenna when no stance did for this long  // a GNSS epoch's carrier status holds for this long (docs/carrier.md §6)
+// Antenna states: a GNSS epoch outside a stance ties the antenna when no stance did for this long [s].
+constexpr double kAntennaTieMaxGapS = 2.0;  // a GNSS epoch's carrier status holds for this long (docs/carrier.md §6)
 constexpr double kReinitSigmaYawRad = 30.0 * 3.14159265358979323846 / 180.0;
 constexpr double kReinitSigmaVelMps = 2.0;
 constexpr double kReinitSigmaPosM = 10.0;  // an epoch least-squares position (single epoch, possibly undifferenced)
@@ -173,7 +174,7 @@ Expected<void> ForwardRunner::run(size_t start, const ins::NavState& nav0, const
     }
     // GNSS epochs up to the interval end.
     while (po.gnss && o_.mode == Mode::kTightlyCoupled && in_.rover && gi < in_.rover->size() && (*in_.rover)[gi].time <= inc.t1) {
-      if (f.has_antenna() && inc.t1.ns() - last_tie_ns > static_cast<int64_t>(kAntennaTieMaxGapS * 1e9)) {
+      if (f.has_antenna() && !stance && inc.t1.ns() - last_tie_ns > static_cast<int64_t>(kAntennaTieMaxGapS * 1e9)) {
         if (antenna_tie_update(f, o_, stride_, /*mid_stance=*/false, sum)) last_tie_ns = inc.t1.ns();
       }
       gnss_.update(f, gi, inc.t1, stride_, clock_initialized, sum, last_used, last_rejected,

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // The antenna states of the tight coupling with carrier (fusion/antenna_state.*, docs/carrier.md §10): the tie's
 // Jacobian (eq. 10.2) against central differences through the error-state boxplus (p + δp, v + δv, exp([φ×]) R,
-// antenna p_a + δp_a, v_a + δv_a, arm error b + δb) with and without a stride velocity, the samples the tie is applied at (mid-stance,
-// once per second while standing), the white-acceleration prediction of the antenna block (eq. 10.1), and the
-// consistency gate (eq. 10.4) that inflates a tie's noise when the foot and the antenna disagree beyond both σ's.
+// antenna p_a + δp_a, v_a + δv_a, arm error b + δb) with and without a stride velocity, the samples the tie is
+// applied at (mid-stance, every 10 s while standing), the white-acceleration prediction of the antenna block (eq.
+// 10.1), and the consistency gate (eq. 10.4) that inflates a tie's noise when the foot and the antenna disagree beyond both σ's.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -68,18 +68,21 @@ std::vector<ins::ImuSample> samples_at(double rate_hz, double span_s) {
   return s;
 }
 
-TEST(AntennaTie, AtMidStanceAndOncePerSecondWhileStanding) {
+TEST(AntennaTie, AtMidStanceAndEveryTenSecondsWhileStanding) {
   const auto imu = samples_at(100.0, 20.0);
   std::vector<ins::ZuptDecision> d(imu.size());
   for (size_t i = 100; i < 140; ++i) d[i].stance = true;    // a 0.4-s stance: its middle, sample 119
   for (size_t i = 300; i < 340; ++i) d[i].stance = true;    // another: 319
-  for (size_t i = 500; i < 1000; ++i) d[i].stance = true;   // standing 5.0-9.99 s: 5.5, 6.5, 7.5, 8.5 s
+  for (size_t i = 500; i < 1900; ++i) d[i].stance = true;  // standing 5.0-18.99 s: 5.5 and 15.5 s (kStandingTieSpacingS)
   const std::vector<size_t> t = antenna_tie_samples(d, imu);
-  ASSERT_EQ(t.size(), 6u);
+  ASSERT_EQ(t.size(), 4u);
   EXPECT_EQ(t[0], 119u);
   EXPECT_EQ(t[1], 319u);
   EXPECT_EQ(t[2], 550u);
-  EXPECT_EQ(t[5], 850u);  // 9.5 s is less than 0.5 s before the stance's end
+  EXPECT_EQ(t[3], 1550u);
+  // A stance ending less than 0.5 s after the next spacing point does not get it.
+  for (size_t i = 1900; i < 1990; ++i) d[i].stance = true;  // now 5.0-19.89 s: still 5.5 and 15.5 s
+  EXPECT_EQ(antenna_tie_samples(d, imu).size(), 4u);
   // No stance: no tie sample (the GNSS epochs tie the antenna then, fusion/forward_runner).
   EXPECT_TRUE(antenna_tie_samples(std::vector<ins::ZuptDecision>(imu.size()), imu).empty());
 }
