@@ -161,6 +161,7 @@ std::string to_yaml(const RunConfig& c) {
     const auto& a = c.gnss.ambiguity;
     e << YAML::Key << "ambiguity" << YAML::Value << YAML::BeginMap;
     e << YAML::Key << "ratio_threshold" << YAML::Value << yaml_number(a.ratio_threshold);
+    e << YAML::Key << "tc_ratio_threshold" << YAML::Value << yaml_number(a.tc_ratio_threshold);
     e << YAML::Key << "min_success_rate" << YAML::Value << yaml_number(a.min_success_rate);
     e << YAML::Key << "elevation_mask_deg" << YAML::Value << yaml_number(a.elevation_mask_deg);
     e << YAML::Key << "partial" << YAML::Value << a.partial;

@@ -57,6 +57,9 @@ struct GnssConfig {
   /// `gnss.ambiguity:` integer resolution (docs/carrier.md §3).
   struct Ambiguity {
     double ratio_threshold = 3.0;
+    /// The tight coupling's ratio threshold (`pednav run` with gnss.carrier: on): it holds every validated fix, so it
+    /// accepts more strictly (docs/carrier.md §8; chosen on forest_walk_carrier seeds 2-12, docs/results.md).
+    double tc_ratio_threshold = 4.0;
     double min_success_rate = 0.999;
     double elevation_mask_deg = 15.0;
     bool partial = true;

@@ -48,6 +48,7 @@ void read_gnss_section(YamlMap& top, GnssConfig& out) {
   YamlMap a = g.map("ambiguity");
   auto& o = out.ambiguity;
   a.number("ratio_threshold", o.ratio_threshold, false, 1.0, 1000.0);
+  a.number("tc_ratio_threshold", o.tc_ratio_threshold, false, 1.0, 1000.0);
   a.number("min_success_rate", o.min_success_rate, false, 0.0, 1.0);
   a.number("elevation_mask_deg", o.elevation_mask_deg, false, 0.0, 90.0);
   a.boolean("partial", o.partial);

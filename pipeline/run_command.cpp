@@ -129,7 +129,7 @@ static nlohmann::json carrier_json(const fusion::EngineSummary& sum, const std::
     slips[gnss::slip_reason_name(static_cast<gnss::SlipReason>(i))] = k.slips[i];
   }
   c["slips"] = slips;
-  // Antenna states (docs/carrier.md §10): foot-to-antenna ties (position and velocity halves) inside the χ² gate, and
+  // Antenna states (docs/carrier.md §10): foot-to-antenna tie halves (position, velocity) inside the χ² gate, and
   // beyond it (applied with their noise inflated, eq. 10.4).
   c["antenna_ties"] = {{"consistent", k.antenna_ties}, {"inflated", k.antenna_ties_inflated}};
   return c;
@@ -208,6 +208,8 @@ fusion::EngineOptions engine_options(const RunConfig& c) {
   o.carrier_sigma_zenith_m = c.gnss.carrier_sigma_zenith_m;
   o.carrier_base_age_sigma_mps = c.gnss.carrier_base_age_sigma_mps;
   o.ambiguity = ambiguity_options(c.gnss);
+  // The tight coupling holds every validated fix: its own, stricter ratio threshold (docs/carrier.md §8).
+  o.ambiguity.ratio_threshold = c.gnss.ambiguity.tc_ratio_threshold;
   o.antenna_accel_sigma_horizontal_mps2 = c.gnss.rtk_accel_sigma_horizontal_mps2;  // the RTK antenna's (eq. 10.1)
   o.antenna_accel_sigma_vertical_mps2 = c.gnss.rtk_accel_sigma_vertical_mps2;
   const ImuErrorModelChoice m = imu_error_model_choice(c);

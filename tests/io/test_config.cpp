@@ -268,6 +268,30 @@ TEST(Config, ZuptEdgeKeyReachesTheEngineAndRoundTrips) {
   EXPECT_THAT(bad.error().message, HasSubstr("zupt.edge_s: value -0.01 is out of range"));
 }
 
+TEST(Config, AntennaStateKeysAndResolvedRoundTrip) {
+  // The antenna states' tie at mid-stance and the tight coupling's ratio threshold (docs/carrier.md §8, §10).
+  const std::string files = "mode: tc\nrover_obs: r.obs\nnav: n.nav\n";
+  auto def = parse(files);
+  ASSERT_TRUE(def) << def.error().message;
+  EXPECT_DOUBLE_EQ(def->antenna.stance_sigma_horizontal_m, 0.1);
+  EXPECT_DOUBLE_EQ(def->antenna.stance_sigma_vertical_m, 0.1);
+  EXPECT_DOUBLE_EQ(def->gnss.ambiguity.tc_ratio_threshold, 4.0);
+  auto cfg = parse(files + "antenna: {stance_sigma_horizontal_m: 0.05, stance_sigma_vertical_m: 0.2}\n"
+                           "gnss: {ambiguity: {tc_ratio_threshold: 5.5}}\n");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  auto again = parse(to_yaml(*cfg));
+  ASSERT_TRUE(again) << again.error().message << "\n" << to_yaml(*cfg);
+  EXPECT_DOUBLE_EQ(again->antenna.stance_sigma_horizontal_m, 0.05);
+  EXPECT_DOUBLE_EQ(again->antenna.stance_sigma_vertical_m, 0.2);
+  EXPECT_DOUBLE_EQ(again->gnss.ambiguity.tc_ratio_threshold, 5.5);
+  auto bad = parse(files + "antenna: {stance_sigma_horizontal_m: 0}\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("antenna.stance_sigma_horizontal_m: value 0 is out of range"));
+  auto bad_ratio = parse(files + "gnss: {ambiguity: {tc_ratio_threshold: 0.5}}\n");
+  ASSERT_FALSE(bad_ratio);
+  EXPECT_THAT(bad_ratio.error().message, HasSubstr("gnss.ambiguity.tc_ratio_threshold: value 0.5 is out of range"));
+}
+
 TEST(Config, AntennaVelocityModelKeysAndResolvedRoundTrip) {
   const std::string files = "mode: gnss\nrover_obs: r.obs\nnav: n.nav\n";
   auto def = parse(files);
