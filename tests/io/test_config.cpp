@@ -270,7 +270,7 @@ TEST(Config, ZuptEdgeKeyReachesTheEngineAndRoundTrips) {
 
 TEST(Config, AntennaStateKeysAndResolvedRoundTrip) {
   // The antenna states' tie at mid-stance and the tight coupling's ratio threshold (docs/carrier.md §8, §10).
-  const std::string files = "mode: tc\nrover_obs: r.obs\nnav: n.nav\n";
+  const std::string files = "mode: gnss\nrover_obs: r.obs\nnav: n.nav\n";
   auto def = parse(files);
   ASSERT_TRUE(def) << def.error().message;
   EXPECT_DOUBLE_EQ(def->antenna.stance_sigma_horizontal_m, 0.1);
