@@ -264,14 +264,8 @@ void GnssEpochUpdater::update(ErrorStateFilter& f, size_t gi, GpsTime t_proc, co
     clock_initialized = true;
   }
   // Noise: independent per measurement + the non-rigid antenna offset/velocity common to all satellites.
-  const Eigen::Matrix3d Ren = R_e_n(llh.lat, llh.lon);
-  const Eigen::Matrix3d C_pos = Ren * Vector3d(o_.antenna_sigma_horizontal_m * o_.antenna_sigma_horizontal_m,
-                                               o_.antenna_sigma_horizontal_m * o_.antenna_sigma_horizontal_m,
-                                               o_.antenna_sigma_vertical_m * o_.antenna_sigma_vertical_m)
-                                          .asDiagonal() * Ren.transpose();
-  const double svh = v_stride ? o_.antenna_stride_velocity_sigma_horizontal_mps : o_.antenna_velocity_sigma_horizontal_mps;
-  const double svv = v_stride ? o_.antenna_stride_velocity_sigma_vertical_mps : o_.antenna_velocity_sigma_vertical_mps;
-  const Eigen::Matrix3d C_vel = Ren * Vector3d(svh * svh, svh * svh, svv * svv).asDiagonal() * Ren.transpose();
+  const Eigen::Matrix3d C_pos = antenna_position_cov_e(o_, p_a);
+  const Eigen::Matrix3d C_vel = antenna_velocity_cov_e(o_, p_a, v_stride.has_value());
   // With antenna states the offset is in the state (eq. 10.3): no common term.
   const CommonAntennaNoise noise{ant ? Eigen::Matrix3d::Zero() : C_pos, ant ? Eigen::Matrix3d::Zero() : C_vel};
   std::vector<int>& active = active_;
