@@ -49,6 +49,10 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
       ->excludes("--bias-random-walk");
   cmd->add_flag("!--no-saturation-repair", mo->saturation_repair,
                 "Integrate clipped IMU samples as they are (`saturation: {repair: false}`)");
+  cmd->add_flag("--carrier", mo->carrier,
+                "L1 carrier phase in the tight coupling (`gnss: {carrier: on}`, antenna states; the scenario must set "
+                "gnss.carrier_phase): runs.csv and summary.json add the fix rate, wrong fixes (antenna > 0.10 m off) and "
+                "the fixed antenna's NEES (docs/consistency.md §6)");
   cmd->add_flag("--no-doppler", mo->no_doppler, "Code rows only, no Doppler rows (`gnss: {use_doppler: false}`)");
   cmd->add_flag("--foot-antenna-velocity", mo->foot_antenna_velocity,
                 "Doppler rows predict the antenna velocity as the foot's own (`antenna: {velocity_model: foot}`; "
@@ -57,7 +61,7 @@ void add_montecarlo_command(CLI::App& app, Action& action) {
                   "k of the code/Doppler weight's elevation factor (gnss.elevation_weight, default 1; docs/gnss.md eq. W1)")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--receiver-weights", mo->receiver_weights,
-                "Code/Doppler weights from the scenario's receiver model (DLL thermal noise at its zenith C/N0, no "
+                "Code/Doppler weights (with --carrier also the phase sigma) from the scenario's receiver model (DLL thermal noise at its zenith C/N0, no "
                 "elevation factor unless --elevation-weight; docs/consistency.md §3.8) instead of pednav run's defaults");
   cmd->add_flag("--scenario-lever-arm", mo->scenario_lever_arm,
                 "Antenna lever arm from the scenario's walker: antenna height above the foot IMU (NED) and the IMU foot "

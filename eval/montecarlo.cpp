@@ -170,4 +170,33 @@ std::vector<McWindowBand> window_bands(const std::vector<McEpochStats>& epochs, 
   return out;
 }
 
+McCarrierSummary summarize_carrier(const std::vector<McRun>& runs) {
+  McCarrierSummary s;
+  s.runs = static_cast<int>(runs.size());
+  double nees = 0.0;
+  std::vector<double> ttff;
+  for (const McRun& r : runs) {
+    const McCarrierRun& c = r.carrier;
+    s.gnss_epochs += c.gnss_epochs;
+    s.fixed_epochs += c.fixed_epochs;
+    s.wrong_fixed_epochs += c.wrong_fixed_epochs;
+    s.runs_with_fix += c.fixed_epochs > 0;
+    s.runs_with_wrong_fix += c.wrong_fixed_epochs > 0;
+    nees += c.antenna_nees_sum;
+    if (c.fixed_epochs > 0 && c.time_to_first_fix_s >= 0.0) ttff.push_back(c.time_to_first_fix_s);
+  }
+  if (s.gnss_epochs > 0) s.fix_rate = static_cast<double>(s.fixed_epochs) / static_cast<double>(s.gnss_epochs);
+  if (s.fixed_epochs > 0) {
+    s.wrong_fix_rate = static_cast<double>(s.wrong_fixed_epochs) / static_cast<double>(s.fixed_epochs);
+    s.mean_antenna_nees_fixed = nees / static_cast<double>(s.fixed_epochs);
+  }
+  if (!ttff.empty()) {
+    std::sort(ttff.begin(), ttff.end());
+    const size_t n = ttff.size();
+    s.median_time_to_first_fix_s = n % 2 ? ttff[n / 2] : 0.5 * (ttff[n / 2 - 1] + ttff[n / 2]);
+    s.max_time_to_first_fix_s = ttff.back();
+  }
+  return s;
+}
+
 }  // namespace pednav::eval

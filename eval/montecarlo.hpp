@@ -21,11 +21,39 @@ struct McEpoch {
   double var_yaw_rad2 = 0.0;                              ///< filter yaw variance [rad²]
 };
 
+/// Carrier-phase figures of one run's forward solution at its GNSS epochs (`pednav montecarlo --carrier`,
+/// docs/consistency.md §6): how often the antenna was fixed, how often a fixed antenna was off by more than a wrong-fix
+/// threshold, and the antenna's horizontal NEES on its fixed epochs (cm-level σ must mean cm-level error).
+struct McCarrierRun {
+  int gnss_epochs = 0;             ///< output epochs at a GNSS epoch (the scored ones)
+  int fixed_epochs = 0;            ///< of those, with status fixed
+  int wrong_fixed_epochs = 0;      ///< fixed, with the antenna's horizontal error above the wrong-fix threshold
+  double antenna_nees_sum = 0.0;   ///< Σ over the fixed epochs of e_hᵀ P_h⁻¹ e_h of the antenna (2 dof)
+  double time_to_first_fix_s = -1.0;  ///< first fixed epoch since the first scored one [s]; < 0: never fixed
+};
+
 /// One run: its forward and (optional, same epochs) smoothed errors.
 struct McRun {
   std::vector<McEpoch> forward;
   std::vector<McEpoch> smoothed;
+  McCarrierRun carrier;  ///< zero unless the study ran with the carrier phase
 };
+
+/// The carrier-phase figures of a study (summary.json `carrier`).
+struct McCarrierSummary {
+  int runs = 0;
+  int runs_with_fix = 0;            ///< runs with at least one fixed epoch
+  int runs_with_wrong_fix = 0;      ///< runs with at least one wrong fixed epoch
+  long gnss_epochs = 0, fixed_epochs = 0, wrong_fixed_epochs = 0;
+  double fix_rate = 0.0;            ///< fixed / GNSS epochs over all runs
+  double wrong_fix_rate = 0.0;      ///< wrong fixed / fixed epochs (0 without fixed epochs)
+  double mean_antenna_nees_fixed = 0.0;  ///< mean antenna horizontal NEES over all fixed epochs (2 when honest)
+  double median_time_to_first_fix_s = -1.0;  ///< over the runs with a fix (< 0: none)
+  double max_time_to_first_fix_s = -1.0;
+};
+
+/// Pools the runs' carrier figures.
+McCarrierSummary summarize_carrier(const std::vector<McRun>& runs);
 
 /// Statistics of one output epoch across the runs that have it (seed 000 eq. for ē, σ̄; Bar-Shalom 2001 §5.4 NEES).
 struct McEpochStats {

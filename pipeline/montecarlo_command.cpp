@@ -13,6 +13,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <set>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
@@ -20,6 +21,7 @@
 #include "core/geodesy.hpp"
 #include "core/rotation.hpp"
 #include "eval/montecarlo.hpp"
+#include "fusion/ambiguity.hpp"
 #include "fusion/engine.hpp"
 #include "io/atomic_file.hpp"
 #include "io/config.hpp"
@@ -27,6 +29,7 @@
 #include "io/plot.hpp"
 #include "io/plot_figures.hpp"
 #include "io/scenario_config.hpp"
+#include "pipeline/montecarlo_runs.hpp"
 #include "pipeline/run_command.hpp"
 #include "pipeline/simulate_command.hpp"
 #include "sim/gnss_sim.hpp"
@@ -38,24 +41,9 @@ namespace {
 // Mode ins starts every run from the true position and heading; its P says so (1 cm, 0.1°: small, not zero).
 constexpr double kTrueStartSigmaPosM = 0.01;
 constexpr double kTrueStartSigmaYawRad = 0.1 * 3.14159265358979323846 / 180.0;
-
-
-// One finished run (what runs.csv shows), with its per-epoch errors.
-struct RunRecord {
-  int index = 0;
-  uint64_t seed = 0;
-  bool ok = false;
-  std::string message;
-  double wall_s = 0.0;
-  double distance_m = 0.0;
-  eval::McRun run;
-};
-
-std::string run_file(const std::string& out, int i) {
-  char b[32];
-  std::snprintf(b, sizeof b, "run_%04d.csv", i);
-  return (std::filesystem::path(out) / "runs" / b).string();
-}
+// A fixed antenna more than this far (horizontal) from the simulated antenna is a wrong fix (L1: a wrong integer
+// moves it by ≥ 0.19 m along some direction; scripts/carrier_seeds uses the same threshold).
+constexpr double kWrongFixHorizontalM = 0.10;
 
 double yaw_n(const ins::NavState& x) {
   const Geodetic llh = geodetic_from_ecef(x.p_eb_e);
@@ -82,6 +70,33 @@ std::vector<eval::McEpoch> errors(const sim::Simulation& s, const std::vector<fu
     out.push_back(m);
   }
   return out;
+}
+
+// The forward solution's carrier figures at the GNSS epochs (docs/consistency.md §6): status, the antenna against the
+// simulated antenna, its horizontal NEES where fixed.
+eval::McCarrierRun carrier_figures(const sim::Simulation& s, const std::vector<fusion::EpochOutput>& sol) {
+  eval::McCarrierRun c;
+  std::set<long long> gnss_ms;
+  for (const auto& ep : s.gnss.rover.epochs) gnss_ms.insert(std::llround((ep.time - s.scenario.start) * 1e3));
+  const auto& nav = s.truth.nav;
+  const double rate = s.scenario.imu.rate_hz;
+  double first_s = -1.0;
+  for (const auto& e : sol) {
+    const double t_s = e.t - s.scenario.start;
+    if (!gnss_ms.count(std::llround(t_s * 1e3))) continue;
+    const long i = std::lround((e.t - nav.front().t) * rate);
+    if (i < 0 || i >= static_cast<long>(s.antenna.size()) || std::abs(nav[i].t - e.t) > 1e-6) continue;
+    if (first_s < 0.0) first_s = t_s;
+    ++c.gnss_epochs;
+    if (static_cast<fusion::SolutionStatus>(e.solution_status) != fusion::SolutionStatus::kFixed || !e.has_antenna) continue;
+    if (c.fixed_epochs++ == 0) c.time_to_first_fix_s = t_s - first_s;
+    const Eigen::Vector3d enu = enu_from_ecef(e.ant_p_e, s.antenna[i].p_e);
+    const Eigen::Vector2d err_ne(enu.y(), enu.x());
+    if (err_ne.norm() > kWrongFixHorizontalM) ++c.wrong_fixed_epochs;
+    const Eigen::Matrix2d P = 0.5 * (e.cov_ant_p_n.topLeftCorner<2, 2>() + e.cov_ant_p_n.topLeftCorner<2, 2>().transpose());
+    c.antenna_nees_sum += err_ne.dot(P.ldlt().solve(err_ne));
+  }
+  return c;
 }
 
 // Simulate and run one seed (thread-safe: in-memory simulation and engine, no RTKLIB).
@@ -126,6 +141,14 @@ RunRecord run_one(const io::ScenarioFile& file, const MontecarloArgs& mo, int in
   if (mo.no_doppler) o.use_doppler = false;
   if (mo.foot_antenna_velocity) o.antenna_velocity_model = fusion::AntennaVelocityModel::kFoot;
   if (mo.white_code) o.multipath_sigma_m = 0.0;
+  if (mo.carrier) {  // what load_run_inputs does for gnss.carrier: on (docs/carrier.md §8, §10)
+    if (!sc.gnss.carrier_phase) {
+      r.message = "--carrier needs a scenario with gnss.carrier_phase: true";
+      return r;
+    }
+    o.carrier = true;
+    o.antenna_state = true;
+  }
   o.zupt_updates = mo.zupt_updates;
   o.step_velocity.enabled = mo.step_velocity;
   o.step_velocity.leg_length_m = mo.leg_length_m;
@@ -160,71 +183,7 @@ RunRecord run_one(const io::ScenarioFile& file, const MontecarloArgs& mo, int in
   r.distance_m = s->antenna.empty() ? 0.0 : s->antenna.back().route_m;
   r.run.forward = errors(*s, res->epochs);
   r.run.smoothed = errors(*s, res->smoothed);
-  return r;
-}
-
-// Per-run file: a '#' header line with the run facts, then one row per epoch and solution.
-constexpr const char* kRunHeader =
-    "solution,t_s,distance_m,err_n_m,err_e_m,err_d_m,cov_nn_m2,cov_ne_m2,cov_nd_m2,cov_ee_m2,cov_ed_m2,cov_dd_m2,"
-    "err_yaw_rad,var_yaw_rad2";
-
-Expected<void> write_run(const std::string& path, const RunRecord& r) {
-  std::ostringstream o;
-  o.precision(17);  // lossless: a run read back (resume, shard merge) aggregates to the same bits as one in memory
-  std::string msg = r.message;
-  std::replace(msg.begin(), msg.end(), '\n', ' ');
-  o << "# index=" << r.index << " seed=" << r.seed << " ok=" << r.ok << " wall_s=" << r.wall_s
-    << " distance_m=" << r.distance_m << " message=" << msg << "\n" << kRunHeader << "\n";
-  for (int k = 0; k < 2; ++k) {
-    for (const auto& e : k == 0 ? r.run.forward : r.run.smoothed) {
-      const auto& C = e.cov_ned_m2;
-      o << (k == 0 ? "forward" : "smoothed") << ',' << e.t_s << ',' << e.distance_m << ',' << e.err_ned_m.x() << ','
-        << e.err_ned_m.y() << ',' << e.err_ned_m.z() << ',' << C(0, 0) << ',' << C(0, 1) << ',' << C(0, 2) << ','
-        << C(1, 1) << ',' << C(1, 2) << ',' << C(2, 2) << ',' << e.err_yaw_rad << ',' << e.var_yaw_rad2 << '\n';
-    }
-  }
-  return io::write_file_atomic(path, o.str());
-}
-
-Expected<RunRecord> read_run(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  if (!std::getline(in, line) || line.rfind("# index=", 0) != 0) return make_error(path + ":1: expected '# index=...'");
-  RunRecord r;
-  auto field = [&](const std::string& key) {
-    const auto p = line.find(" " + key + "=");
-    if (p == std::string::npos) return std::string();
-    const auto b = p + key.size() + 2;
-    const auto e = key == "message" ? std::string::npos : line.find(' ', b);
-    return line.substr(b, e == std::string::npos ? std::string::npos : e - b);
-  };
-  r.index = std::atoi(line.substr(8).c_str());
-  r.seed = std::strtoull(field("seed").c_str(), nullptr, 10);
-  r.ok = field("ok") == "1";
-  r.wall_s = std::atof(field("wall_s").c_str());
-  r.distance_m = std::atof(field("distance_m").c_str());
-  r.message = field("message");
-  std::getline(in, line);  // column header
-  long row = 2;
-  while (std::getline(in, line)) {
-    ++row;
-    std::stringstream ss(line);
-    std::string sol, cell;
-    std::getline(ss, sol, ',');
-    std::vector<double> v;
-    while (std::getline(ss, cell, ',')) v.push_back(std::atof(cell.c_str()));
-    if (v.size() != 13 || (sol != "forward" && sol != "smoothed")) {
-      return make_error(path + ":" + std::to_string(row) + ": expected 14 columns (" + kRunHeader + ")");
-    }
-    eval::McEpoch e;
-    e.t_s = v[0];
-    e.distance_m = v[1];
-    e.err_ned_m = Eigen::Vector3d(v[2], v[3], v[4]);
-    e.cov_ned_m2 << v[5], v[6], v[7], v[6], v[8], v[9], v[7], v[9], v[10];
-    e.err_yaw_rad = v[11];
-    e.var_yaw_rad2 = v[12];
-    (sol == "forward" ? r.run.forward : r.run.smoothed).push_back(e);
-  }
+  if (mo.carrier) r.run.carrier = carrier_figures(*s, res->epochs);
   return r;
 }
 
@@ -271,7 +230,9 @@ Expected<void> aggregate(const MontecarloArgs& mo, const std::string& scenario_n
   std::ostringstream rc;
   rc.precision(8);
   rc << "run,seed,ok,wall_s,distance_m,epochs,forward_rms_horizontal_m,smoothed_rms_horizontal_m,"
-        "forward_final_horizontal_m,message\n";
+        "forward_final_horizontal_m,message";
+  if (mo.carrier) rc << ",gnss_epochs,fixed_epochs,wrong_fixed_epochs,time_to_first_fix_s";
+  rc << "\n";
   double run_wall_sum = 0;
   for (const auto& r : records) {
     run_wall_sum += r.wall_s;
@@ -280,7 +241,10 @@ Expected<void> aggregate(const MontecarloArgs& mo, const std::string& scenario_n
     std::replace(msg.begin(), msg.end(), ',', ';');
     rc << r.index << ',' << r.seed << ',' << r.ok << ',' << r.wall_s << ',' << r.distance_m << ',' << f.size() << ','
        << horizontal_rms(f) << ',' << horizontal_rms(r.run.smoothed) << ','
-       << (f.empty() ? std::nan("") : f.back().err_ned_m.head<2>().norm()) << ",\"" << msg << "\"\n";
+       << (f.empty() ? std::nan("") : f.back().err_ned_m.head<2>().norm()) << ",\"" << msg << "\"";
+    const eval::McCarrierRun& c = r.run.carrier;
+    if (mo.carrier) rc << ',' << c.gnss_epochs << ',' << c.fixed_epochs << ',' << c.wrong_fixed_epochs << ',' << c.time_to_first_fix_s;
+    rc << '\n';
     if (r.ok) ok_runs.push_back(r.run);
     else spdlog::warn("montecarlo: run {} (seed {}) failed: {}", r.index, r.seed, r.message);
   }
@@ -338,6 +302,26 @@ Expected<void> aggregate(const MontecarloArgs& mo, const std::string& scenario_n
   j["window_s"] = mo.window_s;
   j["windows_forward"] = windows_json(fwd);
   j["windows_smoothed"] = have_smoothed ? windows_json(smo) : nlohmann::json(nullptr);
+  std::string carrier_text;
+  if (mo.carrier) {  // docs/consistency.md §6
+    const eval::McCarrierSummary k = eval::summarize_carrier(ok_runs);
+    auto seconds = [](double v) { return v < 0.0 ? nlohmann::json(nullptr) : nlohmann::json(v); };
+    j["carrier"] = {{"gnss_epochs", k.gnss_epochs},
+                    {"fixed_epochs", k.fixed_epochs},
+                    {"fix_rate_pct", 100.0 * k.fix_rate},
+                    {"wrong_fixed_epochs", k.wrong_fixed_epochs},
+                    {"wrong_fix_rate_pct", 100.0 * k.wrong_fix_rate},
+                    {"wrong_fix_horizontal_m", kWrongFixHorizontalM},
+                    {"runs_with_fix", k.runs_with_fix},
+                    {"runs_with_wrong_fix", k.runs_with_wrong_fix},
+                    {"mean_antenna_nees_fixed", k.fixed_epochs > 0 ? nlohmann::json(k.mean_antenna_nees_fixed) : nullptr},
+                    {"median_time_to_first_fix_s", seconds(k.median_time_to_first_fix_s)},
+                    {"max_time_to_first_fix_s", seconds(k.max_time_to_first_fix_s)}};
+    carrier_text = fmt::format("; carrier: {:.1f} % of {} GNSS epochs fixed, {} wrong ({:.2f} %) in {} of {} runs, "
+                               "fixed antenna NEES {:.2f}",
+                               100.0 * k.fix_rate, k.gnss_epochs, k.wrong_fixed_epochs, 100.0 * k.wrong_fix_rate,
+                               k.runs_with_wrong_fix, k.runs, k.mean_antenna_nees_fixed);
+  }
   for (const auto& [name, text] : {std::pair<std::string, std::string>{"runs.csv", rc.str()},
                                    {"nees.csv", nc.str()},
                                    {"summary.json", j.dump(2) + "\n"}}) {
@@ -370,9 +354,10 @@ Expected<void> aggregate(const MontecarloArgs& mo, const std::string& scenario_n
                                   ss.rms_horizontal_m)
                     : std::string("none");
   spdlog::info("montecarlo: {} runs ({} failed) in {:.1f} s on {} threads; forward: NEES in band {:.1f} % of {} "
-               "epochs, sigma ratio horizontal {:.3f} yaw {:.3f}, RMS {:.2f} m; smoothed: {} -> {}",
+               "epochs, sigma ratio horizontal {:.3f} yaw {:.3f}, RMS {:.2f} m; smoothed: {}{} -> {}",
                n_ok, mo.runs - n_ok, wall, jobs, 100.0 * sf.nees_in_band_fraction, sf.epochs,
-               sf.sigma_ratio_horizontal, sf.sigma_ratio_yaw, sf.rms_horizontal_m, smoothed_text, mo.out_dir);
+               sf.sigma_ratio_horizontal, sf.sigma_ratio_yaw, sf.rms_horizontal_m, smoothed_text, carrier_text,
+               mo.out_dir);
   return {};
 }
 
@@ -406,6 +391,7 @@ nlohmann::ordered_json study_json(const MontecarloArgs& a) {
   j["g_sensitivity_states"] = a.g_sensitivity_states;
   j["window_s"] = a.window_s;
   j["receiver_weights"] = a.receiver_weights;
+  if (a.carrier) j["carrier"] = true;  // absent when off: the fingerprints of earlier studies stay valid
   return j;
 }
 
@@ -538,6 +524,7 @@ Expected<void> run_montecarlo_merge(const std::string& out_dir, const std::vecto
       mo.runs = runs;
       mo.summary_from_s = j["study"]["summary_from_s"];
       mo.window_s = j["study"]["window_s"];
+      mo.carrier = j["study"].value("carrier", false);
     } else if (j["study_fingerprint"] != fingerprint || j["shards"] != shards) {
       return make_error(fmt::format("{}: shard of a different study (scenario text, options or shard count differ from "
                                     "{})", path, shard_dirs.front()));

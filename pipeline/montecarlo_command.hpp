@@ -50,6 +50,9 @@ struct MontecarloArgs {
   double window_s = 150.0;         ///< summary.json windows_*: the band test per window of this length [s]
   bool plots = true;               ///< nees.svg, sigma.svg, sigma_yaw.svg, error_vs_distance.svg
   bool receiver_weights = false;   ///< code/Doppler weights from the scenario's receiver model (docs/consistency.md §3.8)
+  /// L1 carrier phase in the tight coupling (`gnss.carrier: on`, antenna states; the scenario must simulate
+  /// `gnss.carrier_phase`): runs.csv and summary.json add the fix rate, wrong fixes and the fixed antenna's NEES.
+  bool carrier = false;
   /// --shard K/N: only runs i with i mod N = K − 1, into out_dir/runs/ with out_dir/shard.json (no statistics);
   /// run_montecarlo_merge combines the N folders into what one process gives.
   int shard_index = 1;

@@ -78,6 +78,7 @@ void apply_data_sheet(const sim::Scenario& sc, const DataSheetParts& parts, RunC
     c.gnss.doppler_sigma_zenith_mps = w.doppler_sigma_zenith_mps;
     c.gnss.elevation_weight = w.elevation_weight;
     c.gnss.code_squaring_loss = w.code_squaring_loss;
+    if (sc.gnss.carrier_phase) c.gnss.carrier_sigma_zenith_m = sim::receiver_carrier_sigma_zenith_m(sc.gnss);
   }
   if (parts.lever_arm && sc.imu.carry == "hand") {  // the device's own antenna (docs/sim.md §9)
     c.antenna.lever_arm_ned_m.setZero();
@@ -141,6 +142,7 @@ std::string format_config(const sim::Simulation& s, const ScenarioFile& f, const
           "  code_squaring_loss: {}\n",
           ds.gnss.cn0_ref_dbhz, ds.gnss.code_sigma_zenith_m, ds.gnss.doppler_sigma_zenith_mps,
           ds.gnss.elevation_weight, ds.gnss.code_squaring_loss);
+      if (sc.gnss.carrier_phase) y += fmt::format("  carrier_sigma_zenith_m: {}\n", ds.gnss.carrier_sigma_zenith_m);
     }
   }
   y += "imu:\n  file: imu.csv\n";

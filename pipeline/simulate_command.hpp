@@ -42,7 +42,8 @@ std::string format_run_config(const sim::Simulation& sim, const io::ScenarioFile
 /// `pednav run`'s generic defaults — what a user copies from the data sheets and a tape measure (docs/sim.md §7,
 /// docs/consistency.md §3.8–3.10).
 struct DataSheetParts {
-  bool receiver_weights = false;  ///< code/Doppler weights = the simulated receiver's DLL thermal and Doppler noise
+  bool receiver_weights = false;  ///< code/Doppler weights = the simulated receiver's DLL thermal and Doppler noise, and (with
+                                  ///< carrier phase) its phase σ (sim::receiver_carrier_sigma_zenith_m)
   bool lever_arm = false;         ///< antenna lever arm = the simulated walker (antenna over the foot, foot beside the line)
   bool g_sensitivity = false;     ///< the IMU spec's gyro g-sensitivity σ = the simulated one (filter consider states)
   bool multipath = false;         ///< multipath states' σ, τ and C/N0 reference = the simulated code multipath

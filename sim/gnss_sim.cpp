@@ -183,6 +183,11 @@ gnss::WeightModel receiver_weight_model(const GnssOptions& o) {
   return w;
 }
 
+double receiver_carrier_sigma_zenith_m(const GnssOptions& o) {
+  return std::hypot(carrier_multipath_sigma_m(o, o.cn0_zenith_dbhz),
+                    kLambdaL1_m * pll_phase_sigma_cycles(o, o.cn0_zenith_dbhz));
+}
+
 GnssSimulation simulate_gnss(const GnssOptions& o, const gnss::NavData& nav, const AntennaFunction& rover_antenna,
                              const Eigen::Vector3d& p_base_e, GpsTime t_begin, GpsTime t_end, uint64_t seed) {
   GnssSimulation out;

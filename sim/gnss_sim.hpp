@@ -112,6 +112,10 @@ double carrier_slip_rate_per_s(const GnssOptions& options, double cn0_dbhz);
 /// falling up to the zenith C/N0). Multipath is not in it: it is a separate, correlated error (the filter's multipath
 /// states).
 gnss::WeightModel receiver_weight_model(const GnssOptions& options);
+/// The phase σ of one receiver at its zenith C/N0 [m]: carrier multipath (eq. 8.4) and PLL thermal noise (eq. 8.3) in
+/// quadrature — gnss.carrier_sigma_zenith_m of the data-sheet configuration (with receiver_weight_model's C/N0
+/// reference). Both grow below that C/N0 like the weight model's factor; the multipath's 10-s correlation is not in it.
+double receiver_carrier_sigma_zenith_m(const GnssOptions& options);
 
 /// Simulate rover and base observations from t_begin to t_end (GPST, epochs on the rate grid) for the given
 /// antenna truth, nav data and options; deterministic from `seed`.

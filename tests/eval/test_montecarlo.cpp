@@ -144,6 +144,31 @@ constexpr int kMcRuns = 2000;         // M
 constexpr int kSteps = 1200;          // K (10 minutes)
 constexpr double kSigmaMatchTol = 0.10;  // issue 9: sample σ within 10 % of √P11 (SE of σ at M = 2000: 1.6 %)
 
+// summarize_carrier pools the runs' carrier figures: rates over all epochs, NEES over all fixed epochs, the first-fix
+// times of the runs with a fix only (a run never fixed has none).
+TEST(MonteCarloStats, CarrierSummaryPoolsTheRuns) {
+  std::vector<McRun> runs(3);
+  runs[0].carrier = {100, 40, 0, 80.0, 30.0};
+  runs[1].carrier = {100, 10, 10, 1000.0, 90.0};
+  runs[2].carrier = {50, 0, 0, 0.0, -1.0};
+  const McCarrierSummary s = summarize_carrier(runs);
+  EXPECT_EQ(s.runs, 3);
+  EXPECT_EQ(s.gnss_epochs, 250);
+  EXPECT_EQ(s.fixed_epochs, 50);
+  EXPECT_EQ(s.wrong_fixed_epochs, 10);
+  EXPECT_DOUBLE_EQ(s.fix_rate, 0.2);
+  EXPECT_DOUBLE_EQ(s.wrong_fix_rate, 0.2);
+  EXPECT_EQ(s.runs_with_fix, 2);
+  EXPECT_EQ(s.runs_with_wrong_fix, 1);
+  EXPECT_DOUBLE_EQ(s.mean_antenna_nees_fixed, 1080.0 / 50.0);
+  EXPECT_DOUBLE_EQ(s.median_time_to_first_fix_s, 60.0);
+  EXPECT_DOUBLE_EQ(s.max_time_to_first_fix_s, 90.0);
+  const McCarrierSummary none = summarize_carrier(std::vector<McRun>(2));
+  EXPECT_EQ(none.fixed_epochs, 0);
+  EXPECT_EQ(none.wrong_fix_rate, 0.0);
+  EXPECT_LT(none.median_time_to_first_fix_s, 0.0) << "no fix: no first-fix time";
+}
+
 TEST(Seed000ChannelFilter, SampleSigmaMatchesFilterSigma) {
   Eigen::Matrix3d Phi;
   Phi << 1, -kG * kT, 0, kT / kEarthR, 1, kT, 0, 0, 1;

@@ -117,6 +117,23 @@ TEST(SimulateCommand, DataSheetConfigLoadsToTheScenarioSensorModels) {
   auto ds2 = io::load_run_config(d2 + "/config_datasheet.yaml");
   ASSERT_TRUE(ds2.has_value()) << ds2.error().message;
   EXPECT_FALSE(ds2->multipath.states);
+  EXPECT_DOUBLE_EQ(ds2->gnss.carrier_sigma_zenith_m, plain->gnss.carrier_sigma_zenith_m) << "no phase: the default";
+
+  // With carrier phase: the phase σ of the simulated receiver (multipath and PLL noise at the zenith C/N0), read back
+  // to the same double, and the same as pednav montecarlo --carrier --receiver-weights gives the filter.
+  f.scenario.gnss.carrier_phase = true;
+  f.scenario.gnss.carrier_multipath_sigma_m = 0.0071;
+  const std::string d3 = test::temp_dir("sim_ds3");
+  ASSERT_TRUE(pipeline::run_simulate_command(f, d3).has_value());
+  auto ds3 = io::load_run_config(d3 + "/config_datasheet.yaml");
+  ASSERT_TRUE(ds3.has_value()) << ds3.error().message;
+  const double want_phase = sim::receiver_carrier_sigma_zenith_m(f.scenario.gnss);
+  EXPECT_DOUBLE_EQ(ds3->gnss.carrier_sigma_zenith_m, want_phase);
+  EXPECT_GT(want_phase, 0.0071) << "multipath and PLL noise in quadrature";
+  EXPECT_LT(want_phase, 0.0071 * 1.05) << "PLL noise at 49 dB-Hz: well under the multipath";
+  io::RunConfig want3 = *io::load_run_config(d3 + "/config.yaml");
+  pipeline::apply_data_sheet(f.scenario, pipeline::DataSheetParts::all(), want3);
+  EXPECT_DOUBLE_EQ(pipeline::engine_options(*ds3).carrier_sigma_zenith_m, pipeline::engine_options(want3).carrier_sigma_zenith_m);
 }
 
 TEST(SimulateCommand, BadScenarioNamesTheKey) {
