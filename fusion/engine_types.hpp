@@ -232,6 +232,14 @@ struct EngineSummary {
   long zupt_samples = 0;             ///< samples flagged as stance by the detector
   long zaru_updates = 0;             ///< ZUPTs that carried ZARU rows
   long zaru_rejected = 0;            ///< ZARU rows dropped by the innovation gate (zaru_gate_probability)
+  /// ZUPT innovations (docs/fusion.md §15): the NIS vᵀS⁻¹v of the three velocity rows of every ZUPT (S = H P Hᵀ + R
+  /// before the update) and of the first ZUPT of each stance, the one that meets the swing's accumulated error; each
+  /// χ²(3) for a model that fits. Sums and counts beyond the 99 % quantile (11.34).
+  double zupt_nis_sum = 0.0;
+  long zupt_nis_above_p99 = 0;
+  long zupt_first_of_stance = 0;
+  double zupt_first_nis_sum = 0.0;
+  long zupt_first_nis_above_p99 = 0;
   /// mechanization intervals closed early at a stance shorter than the interval (ins::zupt_forced_interval_ends)
   long zupt_short_stance_interval_ends = 0;
   long step_velocity_updates = 0;    ///< seed 000 step-velocity updates applied

@@ -14,6 +14,10 @@ namespace pednav::fusion {
 
 using Eigen::Vector3d;
 
+namespace {
+constexpr double kChi2Dof3P99 = 11.3449;  // χ²(3) 99 % quantile
+}  // namespace
+
 Eigen::Matrix<double, 3, 6> zupt_jacobian(const Eigen::Vector3d& v_e, ZuptForm form) {
   // Error state: v_true = v_est + δv, R_true = exp([φ×]) R_est (docs/error_state.md). The velocity error that an
   // attitude error alone produces is φ × v̂ = -[v̂×]φ; the dynamic error (seed 001 eq. 5) is δv_dyn = δv + [v̂×]φ,
@@ -58,6 +62,25 @@ void StanceUpdater::zupt_update(ErrorStateFilter& f, const ins::ImuIncrement& in
     H.middleRows<3>(3) = H_zaru;
     r.tail<3>() = r_zaru;
     R.bottomRightCorner<3, 3>().diagonal().setConstant(zaru_variance(inc));
+  }
+  // The velocity rows' NIS against χ²(3) before the update (docs/fusion.md §15): the run's zupt_innovations check.
+  {
+    // H's velocity rows touch velocity and attitude only (J above): S from their 6 × 6 block, no allocation.
+    const int iv = ins::kVel.offset, ia = ins::kAtt.offset;
+    Eigen::Matrix<double, 6, 6> Pva;
+    Pva << f.P().block<3, 3>(iv, iv), f.P().block<3, 3>(iv, ia), f.P().block<3, 3>(ia, iv), f.P().block<3, 3>(ia, ia);
+    const Eigen::Matrix3d S = J * Pva * J.transpose() + R.topLeftCorner<3, 3>();
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(S);
+    if (ldlt.info() == Eigen::Success) {
+      const double nis = r.head<3>().dot(ldlt.solve(r.head<3>()));
+      sum.zupt_nis_sum += nis;
+      sum.zupt_nis_above_p99 += nis > kChi2Dof3P99;
+      if (!interval_start_stance) {
+        ++sum.zupt_first_of_stance;
+        sum.zupt_first_nis_sum += nis;
+        sum.zupt_first_nis_above_p99 += nis > kChi2Dof3P99;
+      }
+    }
   }
   const Vector3d v_before = v;
   if (!f.update(r, H, R)) return;

@@ -156,6 +156,23 @@ void check_gyro_bias(const fusion::EngineResult& r, const ins::ImuSpec& spec, co
                  "the spec's bias σ is too small for this sensor, or the gyro unit is wrong: try imu.spec: auto"});
 }
 
+// The first ZUPT of each stance meets the error the swing accumulated: its NIS is χ²(3) when the spec's noise and the
+// ZUPT σ describe the foot; the share beyond the 99 % quantile is 1 % then (eq. 15.8).
+void check_zupt_innovations(const fusion::EngineResult& r, const RunWarningLimits& l, std::vector<RunWarning>& out) {
+  const fusion::EngineSummary& s = r.summary;
+  if (s.zupt_first_of_stance < l.zupt_nis_min_stances) return;
+  const double share = static_cast<double>(s.zupt_first_nis_above_p99) / static_cast<double>(s.zupt_first_of_stance);
+  if (share <= l.zupt_nis_max_share) return;
+  out.push_back({"zupt_innovations",
+                 fmt::format("the first ZUPT of {:.1f} % of {} stances is beyond the 99 % χ²(3) quantile of its "
+                             "innovation (1 % expected; mean NIS {:.1f}, 3 expected)",
+                             100.0 * share, s.zupt_first_of_stance,
+                             s.zupt_first_nis_sum / static_cast<double>(s.zupt_first_of_stance)),
+                 100.0 * share, 100.0 * l.zupt_nis_max_share,
+                 "the swing errs more than the IMU model says (running, impacts, a spec from another sensor): try "
+                 "imu.spec: auto, or a spec with larger gyro_arw/accel_vrw, or a larger zupt.sigma_mps"});
+}
+
 }  // namespace
 
 std::vector<RunWarning> run_warnings(const fusion::EngineResult& result, const ins::ImuSpec& spec,
@@ -164,6 +181,7 @@ std::vector<RunWarning> run_warnings(const fusion::EngineResult& result, const i
   check_disagreement(result, limits, out);
   check_gait(result, limits, out);
   check_gyro_bias(result, spec, limits, out);
+  check_zupt_innovations(result, limits, out);
   return out;
 }
 

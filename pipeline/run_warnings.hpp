@@ -37,6 +37,10 @@ struct RunWarningLimits {
   double cadence_max_hz = 2.0;
   double max_stride_s = 3.0;             ///< longer stance-to-stance gaps are pauses, not strides
   double gyro_bias_sigmas = 3.0;         ///< final gyro bias estimate beyond this many of the spec's bias σ
+  /// ZUPT innovations: share of stances whose first ZUPT's NIS is beyond χ²₃(0.99) (1 % when the model fits; at 10
+  /// stances or more a fitting model exceeds 10 % with probability 0.4 % at 10 stances, under 0.1 % from 20 on).
+  double zupt_nis_max_share = 0.10;
+  long zupt_nis_min_stances = 10;
   /// IMU log checks (imu_log_warnings): the 99.9th percentile of |ω| above this is no foot's (swing peaks 5–15 rad/s;
   /// 40 rad/s = 2300 °/s, beyond most MEMS ranges): a unit declared rad/s for data in °/s.
   double gyro_max_plausible_radps = 40.0;

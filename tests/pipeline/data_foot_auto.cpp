@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <sstream>
 
 #include "io/config.hpp"
@@ -72,8 +73,12 @@ std::vector<Trial> read_trials() {
   return out;
 }
 
+std::filesystem::path fresh_dir_path(const std::string& name) {
+  return std::filesystem::temp_directory_path() / ("pednav_data_foot_auto_" + name);
+}
+
 std::filesystem::path fresh_dir(const std::string& name) {
-  const auto d = std::filesystem::temp_directory_path() / ("pednav_data_foot_auto_" + name);
+  const auto d = fresh_dir_path(name);
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
   return d;
@@ -212,6 +217,34 @@ TEST(DataFootAuto, ShortLabelledStancesKeepTheirZupt) {
                 sum.zupt_short_stance_interval_ends);
     EXPECT_LE(err, c.max_m) << c.trial;
     EXPECT_EQ(sum.zupt_short_stance_interval_ends, c.early_ends) << c.trial;
+  }
+}
+
+// The ZUPT-innovation check (docs/fusion.md eq. 15.8) with the minimal configuration: a running trial whose swing errs
+// far beyond the self-calibrated model warns, two walks do not. Measured 2026-12-06: 38 of 41 stances beyond χ²₃(0.99)
+// (mean first-of-stance NIS 471) on 2017-11-27-11-18-11; 0 of 34 and 0 of 24 on 2018-02-09-11-18-04 and
+// 2017-11-22-11-22-03 (mean NIS 0.6 and 2.0). Bounds: the stance counts exact, the share ± 2 stances.
+TEST(DataFootAuto, ZuptInnovationsWarnOnARunningTrialOnly) {
+  const struct {
+    const char* trial;
+    long stances, beyond;
+    bool warns;
+  } cases[] = {{"2017-11-27-11-18-11", 41, 38, true},
+               {"2018-02-09-11-18-04", 34, 0, false},
+               {"2017-11-22-11-22-03", 24, 0, false}};
+  for (const auto& c : cases)
+    PEDNAV_REQUIRE_DATA(test::shared_data(std::string("foot_pyshoe_vicon/csv/") + c.trial + ".csv"));
+  for (const auto& c : cases) {
+    fusion::EngineSummary sum;
+    run_trial(c.trial, {}, &sum);
+    std::printf("[zupt nis %s] %ld of %ld stances beyond the 99 %% quantile, mean first-of-stance NIS %.1f\n", c.trial,
+                sum.zupt_first_nis_above_p99, sum.zupt_first_of_stance,
+                sum.zupt_first_nis_sum / std::max(1L, sum.zupt_first_of_stance));
+    EXPECT_EQ(sum.zupt_first_of_stance, c.stances) << c.trial;
+    EXPECT_NEAR(sum.zupt_first_nis_above_p99, c.beyond, 2) << c.trial;
+    std::ifstream in(fresh_dir_path(c.trial) / "run" / "summary.json");
+    const std::string summary_text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(summary_text.find("\"zupt_innovations\"") != std::string::npos, c.warns) << c.trial;
   }
 }
 

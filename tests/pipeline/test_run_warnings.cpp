@@ -123,6 +123,26 @@ TEST(RunWarnings, GyroBiasBeyondTheSpec) {
   EXPECT_TRUE(run_warnings(r, spec()).empty());
 }
 
+// Eq. 15.8: the first ZUPT of a stance beyond χ²₃(0.99) on more than 10 % of at least 10 stances.
+TEST(RunWarnings, ZuptInnovationsBeyondTheirChiSquareBand) {
+  fusion::EngineResult r = walk({});
+  r.summary.zupt_first_of_stance = 40;
+  r.summary.zupt_first_nis_above_p99 = 12;
+  r.summary.zupt_first_nis_sum = 40 * 25.0;
+  const auto ws = run_warnings(r, spec());
+  ASSERT_EQ(codes(ws), std::vector<std::string>{"zupt_innovations"});
+  EXPECT_NEAR(ws[0].value, 30.0, 1e-9);
+  EXPECT_NEAR(ws[0].limit, 10.0, 1e-9);
+  EXPECT_THAT(ws[0].message, HasSubstr("30.0 % of 40 stances"));
+  EXPECT_THAT(ws[0].message, HasSubstr("mean NIS 25.0"));
+  EXPECT_THAT(ws[0].hint, HasSubstr("zupt.sigma_mps"));
+  r.summary.zupt_first_nis_above_p99 = 4;  // 10 %: at the limit, no warning
+  EXPECT_TRUE(run_warnings(r, spec()).empty());
+  r.summary.zupt_first_of_stance = 9;  // too few stances to judge
+  r.summary.zupt_first_nis_above_p99 = 9;
+  EXPECT_TRUE(run_warnings(r, spec()).empty());
+}
+
 }  // namespace
 }  // namespace pednav::pipeline
 
