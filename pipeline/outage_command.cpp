@@ -8,6 +8,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -16,6 +17,7 @@
 #include <thread>
 
 #include "core/geodesy.hpp"
+#include "fusion/ambiguity.hpp"
 #include "fusion/engine.hpp"
 #include "gnss/measurement.hpp"
 #include "gnss/rtklib/rinex.hpp"
@@ -40,6 +42,15 @@ using Data = RunInputs;
 Expected<Data> load(const RunConfig& c) { return load_run_inputs(c); }
 
 fusion::EngineInputs inputs(const Data& d) { return d.engine_inputs(); }
+
+// Seconds from `from` to the first forward epoch at or after it with status fixed; NaN when there is none.
+double first_fix_after_s(const std::vector<fusion::EpochOutput>& sol, GpsTime from) {
+  for (const auto& e : sol) {
+    if (e.t < from || static_cast<fusion::SolutionStatus>(e.solution_status) != fusion::SolutionStatus::kFixed) continue;
+    return e.t - from;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
 
 bool system_selected(const std::vector<gnss::System>& systems, gnss::System s) {
   return std::find(systems.begin(), systems.end(), s) != systems.end();
@@ -324,6 +335,11 @@ Expected<OutageResult> run_outage_command(const RunConfig& given, const OutageAr
                                                  res.windows[k].start.to_string(), runs[k]->error().message));
     const fusion::EngineResult& r = **runs[k];
     res.epochs_masked.push_back(r.summary.gnss_epochs_masked);
+    if (d.options.carrier) {  // re-fix after the window (docs/outage.md §4)
+      res.carrier = true;
+      res.refix_s.push_back(first_fix_after_s(r.epochs, res.windows[k].end()));
+      res.nominal_fix_s.push_back(first_fix_after_s(nominal->epochs, res.windows[k].start));
+    }
     auto add = [&](std::vector<eval::WindowErrors>& dst, const std::vector<fusion::EpochOutput>& sol,
                    const eval::Trajectory& ref) -> Expected<void> {
       auto we = window_errors(sol, ref, res.windows[k]);
@@ -519,6 +535,21 @@ Expected<OutageResult> run_outage_command(const RunConfig& given, const OutageAr
     if (std::isfinite(f.end_sigma_m)) wl.back()["end_sigma_m"] = f.end_sigma_m;
     wl.back()["scored"] = scored;
     if (!scored) wl.back()["unscored_reason"] = res.unscored_reason[k];
+  }
+  if (res.carrier) {
+    // Re-fix after each window (docs/outage.md §4): null where the run was not fixed again before its end.
+    auto seconds = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+    std::vector<double> got;
+    for (size_t k = 0; k < nw; ++k) {
+      wl[k]["refix_s"] = seconds(res.refix_s[k]);
+      wl[k]["nominal_fix_s"] = seconds(res.nominal_fix_s[k]);
+      if (std::isfinite(res.refix_s[k])) got.push_back(res.refix_s[k]);
+    }
+    std::sort(got.begin(), got.end());
+    j["carrier"] = {{"windows_refixed", got.size()},
+                    {"refix_median_s", got.empty() ? nlohmann::json(nullptr)
+                                                   : nlohmann::json(0.5 * (got[(got.size() - 1) / 2] + got[got.size() / 2]))},
+                    {"refix_max_s", got.empty() ? nlohmann::json(nullptr) : nlohmann::json(got.back())}};
   }
   j["window_list"] = wl;
   j["config"] = c.source_file;

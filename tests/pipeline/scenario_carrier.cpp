@@ -23,6 +23,7 @@
 #include "io/config.hpp"
 #include "io/scenario_config.hpp"
 #include "pipeline/gnss_command.hpp"
+#include "pipeline/outage_command.hpp"
 #include "pipeline/run_command.hpp"
 #include "pipeline/simulate_command.hpp"
 #include "tests/sim/fixtures.hpp"
@@ -150,6 +151,49 @@ TEST(CarrierScenario, TightCouplingWithPhaseHalvesTheForwardError) {
   std::getline(csv_off, h_off);
   EXPECT_THAT(h_on, HasSubstr(",solution_status,n_fixed_ambiguities,ar_ratio"));
   EXPECT_THAT(h_off, ::testing::Not(HasSubstr("solution_status")));
+}
+
+// The outage study's re-fix figures (docs/outage.md §4) on the committed seed, whose forward run is fixed from 73 s
+// to 174 s: full outages of 5 s keep every ambiguity (a gap under the 10-s rule; the INS-predicted geometry passes
+// the w-test), so the first epoch after each window is fixed again; 10-s outages restart them all, and the walk under
+// the canopy re-fixes once (24 s after the window at 90 s, measured 2026-12-06), never after the other three. The
+// run without outage is fixed at each window's start (nominal_fix_s 0).
+TEST(CarrierScenario, OutageStudyReportsTheRefixAfterEachWindow) {
+  io::RunConfig c = config("forest_walk_carrier", "tc", "on");
+  const double t0 = 225000.0;
+  auto study = [&](double duration_s, const std::string& name) {
+    pipeline::OutageArgs a;
+    a.out_dir = test::temp_dir(name);
+    a.start_tow_s = {t0 + 90, t0 + 110, t0 + 130, t0 + 150};
+    a.duration_s = duration_s;
+    a.jobs = 2;
+    a.plot = false;
+    auto r = pipeline::run_outage_command(c, a);
+    EXPECT_TRUE(r) << (r ? "" : r.error().message);
+    return std::make_pair(r ? *r : pipeline::OutageResult{}, summary(a.out_dir));
+  };
+  const auto [short_r, short_j] = study(5.0, "carrier_outage_5");
+  ASSERT_TRUE(short_r.carrier);
+  ASSERT_EQ(short_r.refix_s.size(), 4u);
+  for (size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(short_r.refix_s[k], 0.0) << "window " << k + 1;
+    EXPECT_EQ(short_r.nominal_fix_s[k], 0.0) << "window " << k + 1;
+  }
+  EXPECT_EQ(short_j["carrier"]["windows_refixed"], 4);
+  EXPECT_EQ(short_j["window_list"][0]["refix_s"], 0.0);
+  const auto [long_r, long_j] = study(10.0, "carrier_outage_10");
+  ASSERT_EQ(long_r.refix_s.size(), 4u);
+  std::printf("[forest_walk_carrier outage 10 s] re-fix after each window: %.0f, %.0f, %.0f, %.0f s\n", long_r.refix_s[0],
+              long_r.refix_s[1], long_r.refix_s[2], long_r.refix_s[3]);
+  EXPECT_NEAR(long_r.refix_s[0], 24.0, 5.0);
+  for (size_t k = 1; k < 4; ++k) EXPECT_TRUE(std::isnan(long_r.refix_s[k])) << "window " << k + 1;
+  EXPECT_EQ(long_j["carrier"]["windows_refixed"], 1);
+  EXPECT_TRUE(long_j["window_list"][1]["refix_s"].is_null());
+  // Without the phase the study has no carrier figures.
+  c.gnss.carrier = "off";
+  const auto [off_r, off_j] = study(5.0, "carrier_outage_off");
+  EXPECT_FALSE(off_r.carrier);
+  EXPECT_FALSE(off_j.contains("carrier"));
 }
 
 TEST(CarrierScenario, GnssRtkFixesAndCountsTheSimulatedSlips) {
