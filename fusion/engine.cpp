@@ -58,6 +58,49 @@ double walking_window_share(const std::vector<ins::ImuSample>& samples, size_t b
   return windows > 0 ? static_cast<double>(walking) / windows : 0.0;
 }
 constexpr double kNotOnFootMinTrackM = 20.0;
+// A hand-held walker who stands (docs/fusion.md eq. 8.5): over 1.5 s (three 0.5-s blocks) |f| scatters by less than
+// kHandStandAccelStdMps2 — a walking hand bobs by 1.5-1.8 m/s² (standard deviation over 2 s on the simulated hand; a
+// standing hand's tremor is centimetres per second squared) — and the mean rate is below kHandStandRateRadps (a hand
+// turning the device at rest gets no ZUPT and ZARU).
+constexpr double kHandStandAccelStdMps2 = 0.25;
+constexpr double kHandStandRateRadps = 0.05;
+constexpr double kHandStandBlockS = 0.5;
+
+// Stance decisions of a hand-held IMU from sample `begin` on: standing (eq. 8.5) or not.
+void hand_standing_decisions(const std::vector<ins::ImuSample>& samples, size_t begin,
+                             std::vector<ins::ZuptDecision>& decisions) {
+  struct Block {
+    size_t b = 0, e = 0;
+    double sum_f = 0.0, sum_f2 = 0.0;
+    Vector3d sum_w = Vector3d::Zero();
+  };
+  std::vector<Block> blocks;
+  for (size_t i = begin; i < samples.size();) {
+    Block k;
+    k.b = i;
+    const GpsTime t0 = samples[i].t;
+    for (; i < samples.size() && samples[i].t - t0 < kHandStandBlockS; ++i) {
+      const double f = samples[i].f_ib_b.norm();
+      k.sum_f += f;
+      k.sum_f2 += f * f;
+      k.sum_w += samples[i].omega_ib_b;
+    }
+    k.e = i;
+    blocks.push_back(k);
+  }
+  for (size_t j = 0; j < blocks.size(); ++j) {
+    Block w;  // the block and its neighbours
+    for (size_t m = j > 0 ? j - 1 : 0; m <= std::min(j + 1, blocks.size() - 1); ++m) {
+      w.sum_f += blocks[m].sum_f, w.sum_f2 += blocks[m].sum_f2, w.sum_w += blocks[m].sum_w;
+      w.e += blocks[m].e - blocks[m].b;
+    }
+    const double n = static_cast<double>(w.e);
+    const double mean = w.sum_f / n;
+    const double sd = std::sqrt(std::max(0.0, w.sum_f2 / n - mean * mean));
+    const bool standing = n >= 3 && sd < kHandStandAccelStdMps2 && (w.sum_w / n).norm() < kHandStandRateRadps;
+    for (size_t i = blocks[j].b; i < blocks[j].e && i < decisions.size(); ++i) decisions[i].stance = standing;
+  }
+}
 
 // Largest horizontal distance of the GNSS epoch solutions (every 10th epoch from t_start) from the first one [m];
 // 0 without GNSS.
@@ -132,11 +175,11 @@ Expected<EngineResult> run_forward(const EngineInputs& in, const EngineOptions& 
         walking_window_share(samples, s1) >= kWalkingWindowShare) {
       const double moved_m = gnss_track_extent(in, o, samples[s0].t);
       if (moved_m >= kNotOnFootMinTrackM) {
-        for (size_t i = s1; i < decisions.size(); ++i) decisions[i].stance = false;
+        hand_standing_decisions(samples, s1, decisions);  // ZUPTs only while the walker stands (eq. 8.5)
         opt.antenna_velocity_model = AntennaVelocityModel::kFoot;
         not_on_foot = fmt::format("; rates above {:.0f} rad/s on {:.2f} % of the samples (a foot: about a third) while "
                                   "the GNSS track moves {:.0f} m: an IMU not on a foot (hand-held, pocket, body-worn), "
-                                  "no ZUPT after the levelling window",
+                                  "ZUPTs only while the walker stands",
                                   kFootSwingRateRadps,
                                   100.0 * static_cast<double>(swings) / static_cast<double>(samples.size() - s1),
                                   moved_m);
