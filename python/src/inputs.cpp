@@ -44,15 +44,9 @@ std::string path_of(const py::handle& obj) {
 }
 
 Config config_from_yaml(const py::object& path_obj) {
-  const std::string path = path_of(path_obj);
-  if (!fs::exists(path)) raise(PyExc_FileNotFoundError, path + ": no such file");
-  Expected<io::RunConfig> c = [&] {
-    py::gil_scoped_release nogil;
-    return io::load_run_config(path);
-  }();
-  if (!c) raise(PyExc_ValueError, c.error().message);
-  check_config(*c);
-  return Config{std::make_shared<const io::RunConfig>(std::move(*c))};
+  io::RunConfig c = read_file_or_raise(path_of(path_obj), [](const std::string& p) { return io::load_run_config(p); });
+  check_config(c);
+  return Config{std::make_shared<const io::RunConfig>(std::move(c))};
 }
 
 // "config:<digits>: " at the start of a line → "config: ".

@@ -6,6 +6,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <filesystem>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -14,6 +15,7 @@
 #include "core/time.hpp"
 #include "io/config.hpp"
 #include "io/imu_csv.hpp"
+#include "python/src/convert.hpp"
 
 namespace pednav::python {
 
@@ -21,6 +23,19 @@ namespace py = pybind11;
 
 /// RTKLIB (RINEX reading and writing, LAMBDA) is called from one thread at a time: every call that reaches it holds this.
 std::mutex& rtklib_mutex();
+
+/// A file the caller names, read without the GIL: FileNotFoundError when it does not exist, ValueError with the
+/// reader's message when `read(path)` (returning Expected<T>) fails.
+template <class Read>
+auto read_file_or_raise(const std::string& path, Read read) {
+  if (!std::filesystem::exists(path)) raise(PyExc_FileNotFoundError, path + ": no such file");
+  auto r = [&] {
+    py::gil_scoped_release nogil;
+    return read(path);
+  }();
+  if (!r) raise(PyExc_ValueError, r.error().message);
+  return std::move(*r);
+}
 
 /// A validated run configuration (the YAML of `pednav run` / `pednav config-check`).
 struct Config {

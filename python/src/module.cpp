@@ -290,18 +290,13 @@ py::dict gnss_solution(const Config& config, const std::optional<std::string>& o
 }
 
 py::dict simulate(const py::object& scenario, const std::optional<std::string>& out_dir) {
-  const std::string scenario_path = path_of(scenario);
-  if (!fs::exists(scenario_path)) raise(PyExc_FileNotFoundError, scenario_path + ": no such file");
-  Expected<io::ScenarioFile> sc = [&] {
-    py::gil_scoped_release nogil;
-    return io::load_scenario(scenario_path);
-  }();
-  if (!sc) raise(PyExc_ValueError, sc.error().message);
+  const io::ScenarioFile sc =
+      read_file_or_raise(path_of(scenario), [](const std::string& p) { return io::load_scenario(p); });
   const OutDir dir = out_dir_of(out_dir, "pednav_simulate_");
   Expected<pipeline::SimulateSummary> s = [&] {
     py::gil_scoped_release nogil;
     std::lock_guard<std::mutex> lock(rtklib_mutex());  // RINEX writing through RTKLIB
-    return pipeline::run_simulate_command(*sc, dir.path);
+    return pipeline::run_simulate_command(sc, dir.path);
   }();
   if (!s) raise(PyExc_RuntimeError, s.error().message);
   const fs::path p(dir.path);

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "fusion/rts.hpp"
+#include "tests/support/random_matrix.hpp"
 
 namespace pednav {
 namespace {
@@ -29,14 +30,7 @@ constexpr double kTolState = 1e-9;    // [state units] smoothed mean vs batch WL
 constexpr double kTolCov = 1e-9;      // [state units²] smoothed covariance vs batch WLS
 constexpr double kTolSigmaOrder = 1e-12;  // [state units²] smoothed variance may not exceed the filtered one
 
-MatrixXd random_spd(std::mt19937& rng, int n, double scale) {
-  std::normal_distribution<double> nd(0.0, 1.0);
-  MatrixXd L(n, n);
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) L(i, j) = nd(rng);
-  }
-  return scale * (L * L.transpose() / n + 0.2 * MatrixXd::Identity(n, n));
-}
+using test::random_spd;
 
 struct Meas {
   int step;

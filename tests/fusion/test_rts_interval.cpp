@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "fusion/rts.hpp"
+#include "tests/support/random_matrix.hpp"
 
 namespace pednav {
 namespace {
@@ -20,14 +21,7 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-MatrixXd random_spd(std::mt19937& rng, int n, double scale) {
-  std::normal_distribution<double> nd(0.0, 1.0);
-  MatrixXd L(n, n);
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) L(i, j) = nd(rng);
-  }
-  return scale * (L * L.transpose() / n + 0.2 * MatrixXd::Identity(n, n));
-}
+using test::random_spd;
 
 
 // Everything the engine does inside a mechanization step (docs/fusion.md §12.1, §12.4), on a random 9-state problem:
