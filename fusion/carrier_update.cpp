@@ -18,7 +18,8 @@ using Eigen::MatrixXd;
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 
-constexpr double kPhaseClockSigma_m = 10.0;  // common-mode σ of the phase rows (eq. 8.2)
+constexpr double kPhaseClockSigma_m = 10.0;
+const double kBaseClockSign = std::getenv("PEDNAV_BCS") ? std::atof(std::getenv("PEDNAV_BCS")) : 1.0;  // DEBUG  // common-mode σ of the phase rows (eq. 8.2)
 
 }  // namespace
 
@@ -27,6 +28,20 @@ CarrierUpdater::CarrierUpdater(const gnss::NavData* nav, const std::vector<gnss:
     : nav_(nav), base_(base), o_(o), rover_screen_(o.carrier_slip) {
   slots_.resize(static_cast<size_t>(std::max(0, o.ambiguity_slots)));
   if (base) base_arcs_ = gnss::screen_base_phase(*base, o.carrier_slip);
+}
+
+double CarrierUpdater::base_clock_drift_mps(const gnss::ObsEpoch& base) const {
+  std::vector<double> d;
+  for (const gnss::SatObs& o : base.sats) {
+    if (!std::isfinite(o.doppler_hz) || !std::isfinite(o.wavelength_m) || !std::isfinite(o.pseudorange_m)) continue;
+    auto st = gnss::satellite_state_at_reception(*nav_, o.sat, base.time, o.pseudorange_m);
+    if (!st) continue;
+    const Vector3d u = (st->p_es_e - *o_.base_position_e).normalized();
+    d.push_back(-o.wavelength_m * o.doppler_hz - u.dot(st->v_es_e) + kSpeedOfLight_mps * st->clock_drift_sps);
+  }
+  if (d.empty()) return 0.0;
+  std::nth_element(d.begin(), d.begin() + static_cast<long>(d.size() / 2), d.end());
+  return d[d.size() / 2];
 }
 
 void CarrierUpdater::screen_rover(const gnss::ObsEpoch& rover) {
@@ -73,6 +88,11 @@ CarrierEpoch CarrierUpdater::update(ErrorStateFilter& f, const gnss::ObsEpoch& r
   // The base epoch at its own time (eq. 1.1: the geometry of each receiver's own epoch), not the Doppler-propagated
   // copy the code rows use: a constant-Doppler extrapolation over the Galway base's 14-s gaps is tens of cycles off.
   const gnss::ObsEpoch& be0 = base_ && base_index >= 0 ? (*base_)[base_index] : be;
+  // The base clock's change between its epoch and the rover's (docs/carrier.md eq. 5.2): the code rows' differential
+  // clock is at the rover epoch, the phase rows' base term at the base epoch. From the base's own Doppler: its clock
+  // drift is the median over satellites of −λD − u·v_s + c ḋt_s (the base does not move); zero at a common epoch.
+  const double base_dt_s = re.time - be0.time;
+  const double base_clock_change_m = base_dt_s != 0.0 ? base_clock_drift_mps(be0) * base_dt_s : 0.0;
   std::vector<Row> rows;
   for (const gnss::SatObs& so : re.sats) {
     const auto cs = code_sigma.find(so.sat);
@@ -131,7 +151,8 @@ CarrierEpoch CarrierUpdater::update(ErrorStateFilter& f, const gnss::ObsEpoch& r
     const double lambda = so.wavelength_m;
     rs.pseudorange_m = lambda * so.carrier_cycles;
     bs.pseudorange_m = lambda * bo.carrier_cycles;
-    const gnss::MeasurementRow ph = gnss::sd_carrier_phase(so.sat, rs, bs, p_a_e, *o_.base_position_e, f.clock(clock_slot));
+    gnss::MeasurementRow ph = gnss::sd_carrier_phase(so.sat, rs, bs, p_a_e, *o_.base_position_e, f.clock(clock_slot));
+    ph.residual -= base_clock_change_m;  // the base term at the rover epoch (eq. 5.2)
     const double el = gnss::elevation_azimuth(p_a_e, sr->p_es_e).elevation;
     const double el_b = gnss::elevation_azimuth(*o_.base_position_e, sb->p_es_e).elevation;
     Row r;

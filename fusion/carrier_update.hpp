@@ -67,6 +67,8 @@ class CarrierUpdater {
   std::vector<Slot> slots_;
   int consecutive_fixes_ = 0;
   void restart_all(ErrorStateFilter& f, gnss::SlipReason why, EngineSummary& sum);
+  /// The base receiver's clock drift [m/s] from its epoch's Doppler (median over satellites; 0 without Doppler).
+  double base_clock_drift_mps(const gnss::ObsEpoch& base) const;
 };
 
 }  // namespace pednav::fusion

@@ -13,6 +13,8 @@
 #include <map>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -274,6 +276,82 @@ TEST(CarrierScenario, TightCouplingSurvivesBadCarrierInput) {
   }
   EXPECT_GT(rows_after, 300);
   EXPECT_EQ(fixed_after, 0);
+}
+
+// More bad carrier input in the tight coupling, each alone: one satellite's loss-of-lock flag set on every epoch (its
+// phase restarts at every epoch, counted, and never enters a fix; the others still fix, none wrong), and a base that
+// logged every 30 s only, whose clock change over the age eq. 8.2b removes (docs/carrier.md §8). Measured 2026-12-06:
+// LLI: 1053 flagged phases, 1125 loss-of-lock restarts, 103 fixed antenna epochs at 0.013 m RMS; 30-s base: forward
+// RMS 0.942 m, 108 fixed epochs at 0.010 m, 7 phases flagged by the w-test (without eq. 8.2b: 2.17 m, no fix, 173
+// flagged; code only with the 1-s base 1.08 m). Bounds: the figures + 15 % / − 15 % fixed epochs.
+TEST(CarrierScenario, TightCouplingWithLossOfLockOnEveryEpochOrA30sBase) {
+  const std::string dir = test::temp_dir("carrier_lli_base30");
+  auto rewrite = [&](const std::string& name, const std::function<bool(std::string&, int)>& keep) {
+    std::istringstream in(test::read_text(sim_dir("forest_walk_carrier") + "/" + name));
+    std::ostringstream out;
+    bool header = true, keep_epoch = true;
+    int second = 0;
+    for (std::string line; std::getline(in, line);) {
+      if (header) {
+        out << line << '\n';
+        header = line.find("END OF HEADER") == std::string::npos;
+        continue;
+      }
+      if (!line.empty() && line[0] == '>') {
+        second = static_cast<int>(std::lround(std::stod(line.substr(19, 11))));
+        keep_epoch = keep(line, second);
+      } else if (keep_epoch) {
+        keep(line, second);
+      }
+      if (keep_epoch) out << line << '\n';
+    }
+    std::ofstream(dir + "/" + name, std::ios::binary) << out.str();
+    return dir + "/" + name;
+  };
+  const std::string truth = sim_dir("forest_walk_carrier") + "/truth.csv";
+  {  // loss of lock on every epoch of G09
+    io::RunConfig c = config("forest_walk_carrier", "tc", "on");
+    c.smoother_enabled = false;
+    int flagged = 0;
+    c.gnss.rover_obs = rewrite("rover.obs", [&](std::string& line, int) {
+      if (line.rfind("G09", 0) == 0 && line.size() >= 34 &&
+          line.substr(19, 14).find_first_not_of(' ') != std::string::npos) {
+        line[33] = '1';  // LLI bit 0: loss of lock
+        ++flagged;
+      }
+      return true;
+    });
+    ASSERT_GT(flagged, 300);
+    auto r = pipeline::run_run_command(c, dir + "/lli");
+    ASSERT_TRUE(r) << r.error().message;
+    const auto j = summary(dir + "/lli");
+    const FixedAntenna fa = fixed_antenna_error(truth, dir + "/lli/antenna.csv");
+    std::printf("[carrier LLI on every epoch of G09] %d flagged phases; slips %s; %d fixed antenna epochs, RMS %.3f m\n",
+                flagged, j["carrier"]["slips"].dump().c_str(), fa.n, fa.rms_m);
+    EXPECT_GE(j["carrier"]["slips"]["loss_of_lock"].get<long>(), flagged - 5);
+    EXPECT_GE(fa.n, 87);
+    EXPECT_LT(fa.rms_m, 0.10) << "no wrong fix held";
+  }
+  {  // the base every 30 s
+    io::RunConfig c = config("forest_walk_carrier", "tc", "on");
+    c.smoother_enabled = false;
+    c.gnss.base_obs = rewrite("base.obs", [](std::string& line, int second) { return line[0] != '>' || second % 30 == 0; });
+    auto r = pipeline::run_run_command(c, dir + "/base30");
+    ASSERT_TRUE(r) << r.error().message;
+    const auto j = summary(dir + "/base30");
+    const FixedAntenna fa = fixed_antenna_error(truth, dir + "/base30/antenna.csv");
+    const double rms = j["evaluation"]["horizontal_rms_m"];
+    const long flagged = j["carrier"]["slips"]["geometry"];
+    std::printf("[carrier base every 30 s] forward RMS %.3f m, %d fixed antenna epochs (RMS %.3f m), %ld phases flagged "
+                "by the w-test\n", rms, fa.n, fa.rms_m, flagged);
+    EXPECT_LT(rms, 0.942 * 1.15);
+    EXPECT_GE(fa.n, 92);
+    EXPECT_LT(fa.rms_m, 0.10);
+    EXPECT_LE(flagged, 9);
+  }
+  std::ifstream probe(dir + "/base30/solution.csv");
+  const std::string text((std::istreambuf_iterator<char>(probe)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.find("nan"), std::string::npos);
 }
 
 TEST(CarrierScenario, GnssRtkFixesAndCountsTheSimulatedSlips) {
