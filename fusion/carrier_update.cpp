@@ -18,8 +18,7 @@ using Eigen::MatrixXd;
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 
-constexpr double kPhaseClockSigma_m = 10.0;
-const double kBaseClockSign = std::getenv("PEDNAV_BCS") ? std::atof(std::getenv("PEDNAV_BCS")) : 1.0;  // DEBUG  // common-mode σ of the phase rows (eq. 8.2)
+constexpr double kPhaseClockSigma_m = 10.0;  // common-mode σ of the phase rows (eq. 8.2)
 
 }  // namespace
 
@@ -88,7 +87,7 @@ CarrierEpoch CarrierUpdater::update(ErrorStateFilter& f, const gnss::ObsEpoch& r
   // The base epoch at its own time (eq. 1.1: the geometry of each receiver's own epoch), not the Doppler-propagated
   // copy the code rows use: a constant-Doppler extrapolation over the Galway base's 14-s gaps is tens of cycles off.
   const gnss::ObsEpoch& be0 = base_ && base_index >= 0 ? (*base_)[base_index] : be;
-  // The base clock's change between its epoch and the rover's (docs/carrier.md eq. 5.2): the code rows' differential
+  // The base clock's change between its epoch and the rover's (docs/carrier.md eq. 8.2b): the code rows' differential
   // clock is at the rover epoch, the phase rows' base term at the base epoch. From the base's own Doppler: its clock
   // drift is the median over satellites of −λD − u·v_s + c ḋt_s (the base does not move); zero at a common epoch.
   const double base_dt_s = re.time - be0.time;
@@ -152,7 +151,7 @@ CarrierEpoch CarrierUpdater::update(ErrorStateFilter& f, const gnss::ObsEpoch& r
     rs.pseudorange_m = lambda * so.carrier_cycles;
     bs.pseudorange_m = lambda * bo.carrier_cycles;
     gnss::MeasurementRow ph = gnss::sd_carrier_phase(so.sat, rs, bs, p_a_e, *o_.base_position_e, f.clock(clock_slot));
-    ph.residual -= base_clock_change_m;  // the base term at the rover epoch (eq. 5.2)
+    ph.residual -= base_clock_change_m;  // the base term at the rover epoch (eq. 8.2b)
     const double el = gnss::elevation_azimuth(p_a_e, sr->p_es_e).elevation;
     const double el_b = gnss::elevation_azimuth(*o_.base_position_e, sb->p_es_e).elevation;
     Row r;

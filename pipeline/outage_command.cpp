@@ -335,7 +335,7 @@ Expected<OutageResult> run_outage_command(const RunConfig& given, const OutageAr
                                                  res.windows[k].start.to_string(), runs[k]->error().message));
     const fusion::EngineResult& r = **runs[k];
     res.epochs_masked.push_back(r.summary.gnss_epochs_masked);
-    if (d.options.carrier) {  // re-fix after the window (docs/outage.md §4)
+    if (d.options.carrier) {  // re-fix after the window (docs/outage.md §1.1)
       res.carrier = true;
       res.refix_s.push_back(first_fix_after_s(r.epochs, res.windows[k].end()));
       res.nominal_fix_s.push_back(first_fix_after_s(nominal->epochs, res.windows[k].start));
@@ -537,7 +537,7 @@ Expected<OutageResult> run_outage_command(const RunConfig& given, const OutageAr
     if (!scored) wl.back()["unscored_reason"] = res.unscored_reason[k];
   }
   if (res.carrier) {
-    // Re-fix after each window (docs/outage.md §4): null where the run was not fixed again before its end.
+    // Re-fix after each window (docs/outage.md §1.1): null where the run was not fixed again before its end.
     auto seconds = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
     std::vector<double> got;
     for (size_t k = 0; k < nw; ++k) {

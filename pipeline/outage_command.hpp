@@ -51,7 +51,7 @@ struct OutageResult {
   /// Per window: why the reference could not score it ("" = scored). Such a window has no sample in `forward` and
   /// `smoothed` (its figures against the run without outage remain).
   std::vector<std::string> unscored_reason;
-  /// With the carrier phase (gnss.carrier: on; docs/outage.md §4): per window, seconds from the window's end to the
+  /// With the carrier phase (gnss.carrier: on; docs/outage.md §1.1): per window, seconds from the window's end to the
   /// first forward epoch with status fixed (NaN: none before the run ends), and the same from the window's start in
   /// the run without outage (how long that run took to be fixed there; 0 when it was fixed at the start).
   bool carrier = false;

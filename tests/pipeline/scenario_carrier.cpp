@@ -157,7 +157,7 @@ TEST(CarrierScenario, TightCouplingWithPhaseHalvesTheForwardError) {
   EXPECT_THAT(h_off, ::testing::Not(HasSubstr("solution_status")));
 }
 
-// The outage study's re-fix figures (docs/outage.md §4) on the committed seed, whose forward run is fixed from 73 s
+// The outage study's re-fix figures (docs/outage.md §1.1) on the committed seed, whose forward run is fixed from 73 s
 // to 174 s: full outages of 5 s keep every ambiguity (a gap under the 10-s rule; the INS-predicted geometry passes
 // the w-test), so the first epoch after each window is fixed again; 10-s outages restart them all, and the walk under
 // the canopy re-fixes once (24 s after the window at 90 s, measured 2026-12-06), never after the other three. The
