@@ -91,7 +91,11 @@ CarrierEpoch CarrierUpdater::update(ErrorStateFilter& f, const gnss::ObsEpoch& r
   // clock is at the rover epoch, the phase rows' base term at the base epoch. From the base's own Doppler: its clock
   // drift is the median over satellites of −λD − u·v_s + c ḋt_s (the base does not move); zero at a common epoch.
   const double base_dt_s = re.time - be0.time;
-  const double base_clock_change_m = base_dt_s != 0.0 ? base_clock_drift_mps(be0) * base_dt_s : 0.0;
+  if (base_dt_s != 0.0 && (base_index < 0 || base_index != drift_base_index_)) {  // once per base epoch
+    drift_mps_ = base_clock_drift_mps(be0);
+    drift_base_index_ = base_index;
+  }
+  const double base_clock_change_m = base_dt_s != 0.0 ? drift_mps_ * base_dt_s : 0.0;
   std::vector<Row> rows;
   for (const gnss::SatObs& so : re.sats) {
     const auto cs = code_sigma.find(so.sat);

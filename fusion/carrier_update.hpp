@@ -69,6 +69,8 @@ class CarrierUpdater {
   void restart_all(ErrorStateFilter& f, gnss::SlipReason why, EngineSummary& sum);
   /// The base receiver's clock drift [m/s] from its epoch's Doppler (median over satellites; 0 without Doppler).
   double base_clock_drift_mps(const gnss::ObsEpoch& base) const;
+  int drift_base_index_ = -2;  // base epoch of drift_mps_ (−2: none yet)
+  double drift_mps_ = 0.0;
 };
 
 }  // namespace pednav::fusion

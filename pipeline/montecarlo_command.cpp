@@ -50,14 +50,20 @@ double yaw_n(const ins::NavState& x) {
   return euler_from_R_n_b(R_e_n(llh.lat, llh.lon).transpose() * x.R_e_b()).z();
 }
 
+// The truth sample at an output epoch's time (the IMU-rate grid, GPST), or −1 when the epoch is off the grid.
+long truth_index(const sim::Simulation& s, GpsTime t) {
+  const auto& nav = s.truth.nav;
+  const long i = std::lround((t - nav.front().t) * s.scenario.imu.rate_hz);
+  return i < 0 || i >= static_cast<long>(nav.size()) || std::abs(nav[i].t - t) > 1e-6 ? -1 : i;
+}
+
 // Errors of one solution against the simulation truth (at the IMU rate, GPST on the sample grid).
 std::vector<eval::McEpoch> errors(const sim::Simulation& s, const std::vector<fusion::EpochOutput>& sol) {
   std::vector<eval::McEpoch> out;
   const auto& nav = s.truth.nav;
-  const double rate = s.scenario.imu.rate_hz;
   for (const auto& e : sol) {
-    const long i = std::lround((e.t - nav.front().t) * rate);
-    if (i < 0 || i >= static_cast<long>(nav.size()) || std::abs(nav[i].t - e.t) > 1e-6) continue;
+    const long i = truth_index(s, e.t);
+    if (i < 0) continue;
     eval::McEpoch m;
     m.t_s = e.t - s.scenario.start;
     m.distance_m = i < static_cast<long>(s.antenna.size()) ? s.antenna[i].route_m : 0.0;
@@ -78,14 +84,12 @@ eval::McCarrierRun carrier_figures(const sim::Simulation& s, const std::vector<f
   eval::McCarrierRun c;
   std::set<long long> gnss_ms;
   for (const auto& ep : s.gnss.rover.epochs) gnss_ms.insert(std::llround((ep.time - s.scenario.start) * 1e3));
-  const auto& nav = s.truth.nav;
-  const double rate = s.scenario.imu.rate_hz;
   double first_s = -1.0;
   for (const auto& e : sol) {
     const double t_s = e.t - s.scenario.start;
     if (!gnss_ms.count(std::llround(t_s * 1e3))) continue;
-    const long i = std::lround((e.t - nav.front().t) * rate);
-    if (i < 0 || i >= static_cast<long>(s.antenna.size()) || std::abs(nav[i].t - e.t) > 1e-6) continue;
+    const long i = truth_index(s, e.t);
+    if (i < 0 || i >= static_cast<long>(s.antenna.size())) continue;
     if (first_s < 0.0) first_s = t_s;
     ++c.gnss_epochs;
     if (static_cast<fusion::SolutionStatus>(e.solution_status) != fusion::SolutionStatus::kFixed || !e.has_antenna) continue;
