@@ -11,8 +11,10 @@ Usage: PYTHONPATH=build/python python3 bench/python_bench.py [--bin build/bin/pe
 Prints the medians, the ratios and the process CPU time per wall second (> 1: the threads ran at once); nothing is
 asserted. The machine's other load changes every figure: run it on an otherwise idle machine."""
 import argparse
+import atexit
 import os
 import pathlib
+import shutil
 import statistics
 import subprocess
 import tempfile
@@ -28,6 +30,7 @@ parser.add_argument("--repeats", type=int, default=5)
 args = parser.parse_args()
 
 work = pathlib.Path(tempfile.mkdtemp(prefix="pednav_python_bench_"))
+atexit.register(shutil.rmtree, work, True)
 scenario = (ROOT / "datasets" / "forest_walk.yaml").read_text()
 sims = []
 for seed in (2, 3):
