@@ -110,6 +110,9 @@ void check_gait(const fusion::EngineResult& r, const RunWarningLimits& l, std::v
                        : "stance almost everywhere: lower zupt.shoe_threshold (or use auto), check imu.format's "
                          "units"});
   }
+  std::vector<double> intervals;
+  for (size_t i = 1; i < r.epochs.size(); ++i) intervals.push_back(r.epochs[i].t - r.epochs[i - 1].t);
+  if (intervals.empty() || median(intervals) > l.gait_output_interval_max_s) return;
   const std::vector<Stance> st = stances(r);
   std::vector<double> strides, periods;
   for (size_t i = 1; i < st.size(); ++i) {

@@ -36,6 +36,9 @@ struct RunWarningLimits {
   double cadence_min_hz = 0.3;           ///< strides per second of walking (stance to stance within max_stride_s)
   double cadence_max_hz = 2.0;
   double max_stride_s = 3.0;             ///< longer stance-to-stance gaps are pauses, not strides
+  /// The step and cadence checks read the stances off the output epochs: a stance (0.2-0.5 s) needs a few of them, so
+  /// a coarser output (a 1-Hz GNSS-epoch output catches a third of the stances, and strides of any length) skips them.
+  double gait_output_interval_max_s = 0.1;
   double gyro_bias_sigmas = 3.0;         ///< final gyro bias estimate beyond this many of the spec's bias σ
   /// ZUPT innovations: share of stances whose first ZUPT's NIS is beyond χ²₃(0.99) (1 % when the model fits; at 10
   /// stances or more a fitting model exceeds 10 % with probability 0.4 % at 10 stances, under 0.1 % from 20 on).
