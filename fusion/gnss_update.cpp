@@ -203,7 +203,10 @@ void GnssEpochUpdater::update(ErrorStateFilter& f, size_t gi, GpsTime t_proc, co
         const double c = std::isnan(cn0) ? o_.multipath_cn0_ref_dbhz : cn0;
         return o_.multipath_sigma_m * std::pow(10.0, std::max(0.0, o_.multipath_cn0_ref_dbhz - c) / 20.0);
       };
-      const double s_mp = sd ? std::hypot(mp_sigma(so.cn0_dbhz), mp_sigma(cn0_b)) : mp_sigma(so.cn0_dbhz);
+      // GLONASS: the factor of its code σ applies to the correlated part too (its FDMA inter-frequency biases are
+      // constant per satellite: white, they would average down over a walk and pull the position; eq. M.2a).
+      const double glo = so.sat.system == gnss::System::kGlonass ? o_.weights.glonass_code_factor : 1.0;
+      const double s_mp = glo * (sd ? std::hypot(mp_sigma(so.cn0_dbhz), mp_sigma(cn0_b)) : mp_sigma(so.cn0_dbhz));
       bool reset = false;
       const int ms = f.multipath_slot(so.sat, re.time.ns(), reset);
       if (reset) ++sum.multipath_resets;
