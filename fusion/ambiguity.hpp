@@ -26,7 +26,7 @@ struct AmbiguityOptions {
   double min_success_rate = 0.999;       ///< bootstrapped success rate of the decorrelated set (eq. 3.4)
   double ar_elevation_mask_rad = 15.0 * kDegToRad;  ///< satellites below take part as float only
   bool partial = true;                   ///< drop the lowest satellites while the full set fails
-  int min_ambiguities = 4;               ///< fewest double differences in a fix
+  int min_ambiguities = 6;               ///< fewest double differences in a fix
   int min_lock_epochs = 3;               ///< epochs an ambiguity must have been tracked before it is fixed
   bool hold = false;                     ///< fix-and-hold: validated fixes constrain the float filter
   int hold_min_epochs = 5;               ///< consecutive validated fixes of the same integers before a hold
@@ -35,6 +35,9 @@ struct AmbiguityOptions {
   /// GLONASS SD ambiguities [cycles of each channel] are resolved as integers too: valid when the rover and the base
   /// are receivers of one type (their inter-frequency phase biases cancel), RTKLIB's `pos2-gloarmode = on`.
   bool glonass = false;
+  /// GLONASS integers for receivers of different types: the inter-frequency phase bias rate β is searched (eqs.
+  /// 3.9-3.11, fusion/glonass_ifb) and, once found, removed before GLONASS is resolved as integers.
+  bool glonass_ifb_search = false;
 };
 
 /// One SD ambiguity state offered for resolution.
@@ -44,6 +47,7 @@ struct AmbiguityCandidate {
   double elevation_rad = 0.0;
   int lock_epochs = 0;           ///< epochs since the ambiguity was (re)started
   bool integer = true;           ///< integer-capable (not GLONASS, no half-cycle flag)
+  double wavelength_m = 0.0;     ///< the signal's (GLONASS: its frequency channel, eq. 3.9); 0 = unknown
 };
 
 /// The outcome of one resolution attempt.

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/geodesy.hpp"
+#include "fusion/glonass_ifb.hpp"
 #include "fusion/kinematic_model.hpp"
 #include "gnss/least_squares.hpp"
 
@@ -399,21 +400,37 @@ RtkEpoch RtkFilter::process(const gnss::ObsEpoch& rover, int base_index) {
   for (const Row& rw : rows) {
     if (!rw.active || rw.kind != Row::kPhase || static_cast<size_t>(rw.amb) >= amb_.size()) continue;
     const Amb& a = amb_[rw.amb];
+    const bool glonass = a.sat.system == gnss::System::kGlonass;
     const bool integer = gnss::integer_ambiguity_system(a.sat.system) ||
-                         (o_.ar.glonass && a.sat.system == gnss::System::kGlonass);
-    cands.push_back({amb_index(static_cast<size_t>(rw.amb)), a.sat, sats[rw.sat].el, a.lock_epochs, integer});
+                         (glonass && (o_.ar.glonass || (o_.ar.glonass_ifb_search && ifb_.beta_m())));
+    const int ai = amb_index(static_cast<size_t>(rw.amb));
+    cands.push_back({ai, a.sat, sats[rw.sat].el, a.lock_epochs, integer, rw.h(ai)});
   }
   if (!cands.empty() && x_.size() > n_before_amb) {
     ++sum_.fix_attempts;
-    const AmbiguityFix fix = resolve_ambiguities(x_, P_, cands, o_.ar);
+    // GLONASS of a receiver of another type (eqs. 3.9-3.11): search β while it is unknown, then resolve with it removed.
+    if (o_.ar.glonass_ifb_search && !o_.ar.glonass && !ifb_.beta_m()) {
+      if (ifb_.search(x_, P_, cands, o_.ar)) {
+        sum_.glonass_ifb_m_per_channel = ifb_.beta_m();
+        sum_.glonass_ifb_found_s = rover.time - t_first_.value_or(rover.time);
+        for (auto& c : cands) c.integer = c.integer || c.sat.system == gnss::System::kGlonass;
+      }
+      sum_.glonass_ifb_searches = ifb_.searches();
+      sum_.glonass_ifb_votes = ifb_.votes_cast();
+    }
+    const VectorXd ifb = o_.ar.glonass_ifb_search && ifb_.beta_m()
+                             ? glonass_ifb_offsets(static_cast<int>(x_.size()), cands, *ifb_.beta_m())
+                             : VectorXd::Zero(x_.size());
+    const AmbiguityFix fix = resolve_ambiguities(x_ - ifb, P_, cands, o_.ar);
     out.ratio = fix.ratio;
     if (!fix.fixed) {
       ++sum_.not_fixed[fix.why_not];
       consecutive_fixes_ = 0;
     } else {
-      VectorXd xf = x_;
+      VectorXd xf = x_ - ifb;
       MatrixXd Pf = P_;
       bool valid = condition_on_integers(xf, Pf, fix.D, fix.z, 0.0);
+      xf += ifb;  // the float ambiguity states keep β k / λ (eq. 3.9)
       if (valid) {
         const VectorXd move = xf - x_pre;
         for (const Row& rw : rows) {
@@ -439,8 +456,11 @@ RtkEpoch RtkFilter::process(const gnss::ObsEpoch& rover, int base_index) {
         out.v_ea_e = xf.segment<3>(3);
         out.cov_p_e = Pf.block<3, 3>(0, 0);
         ++consecutive_fixes_;
-        if (o_.ar.hold && consecutive_fixes_ >= o_.ar.hold_min_epochs &&
-            condition_on_integers(x_, P_, fix.D, fix.z, o_.ar.hold_sigma_cycles)) {
+        x_ -= ifb;
+        const bool held = o_.ar.hold && consecutive_fixes_ >= o_.ar.hold_min_epochs &&
+                          condition_on_integers(x_, P_, fix.D, fix.z, o_.ar.hold_sigma_cycles);
+        x_ += ifb;
+        if (held) {
           ++sum_.holds;
           for (Amb& a : amb_) {
             if (std::find(fix.sats.begin(), fix.sats.end(), a.sat) != fix.sats.end()) a.held = true;

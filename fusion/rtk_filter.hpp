@@ -15,6 +15,7 @@
 
 #include "core/time.hpp"
 #include "fusion/ambiguity.hpp"
+#include "fusion/glonass_ifb.hpp"
 #include "gnss/base_phase.hpp"
 #include "gnss/carrier.hpp"
 #include "gnss/measurement.hpp"
@@ -61,6 +62,10 @@ struct RtkSummary {
   std::map<std::string, int> not_fixed;  ///< why an attempt did not fix
   std::optional<double> time_to_first_fix_s;
   int code_rows_excluded = 0, doppler_rows_excluded = 0;
+  /// With gnss.ambiguity.glonass_ifb: search: the GLONASS inter-frequency phase bias rate β found (eq. 3.11) and
+  /// when, in seconds after the first epoch; unset while not found.
+  std::optional<double> glonass_ifb_m_per_channel, glonass_ifb_found_s;
+  int glonass_ifb_searches = 0, glonass_ifb_votes = 0;
 };
 
 class RtkFilter {
@@ -71,6 +76,8 @@ class RtkFilter {
   /// Process rover epoch `rover` with base epoch base_index (−1: none) whose time differs by age_s.
   RtkEpoch process(const gnss::ObsEpoch& rover, int base_index);
   const RtkSummary& summary() const { return sum_; }
+  /// The GLONASS inter-frequency phase bias rate in use [m per channel] (found by search), if any.
+  std::optional<double> glonass_ifb_m_per_channel() const { return ifb_.beta_m(); }
 
  private:
   struct Amb {
@@ -96,6 +103,7 @@ class RtkFilter {
   std::map<gnss::SatId, int> rover_arc_;
   gnss::BasePhaseArcs base_arcs_;
   int consecutive_fixes_ = 0;
+  GlonassIfbSearch ifb_;
   RtkSummary sum_;
 
   int n_clk() const { return static_cast<int>(o_.systems.size()); }

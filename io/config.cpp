@@ -172,6 +172,7 @@ std::string to_yaml(const RunConfig& c) {
     e << YAML::Key << "hold_sigma_cycles" << YAML::Value << yaml_number(a.hold_sigma_cycles);
     e << YAML::Key << "validation_w" << YAML::Value << yaml_number(a.validation_w);
     e << YAML::Key << "glonass" << YAML::Value << a.glonass;
+    e << YAML::Key << "glonass_ifb" << YAML::Value << a.glonass_ifb;
     e << YAML::EndMap;
   }
   e << YAML::EndMap;

@@ -63,13 +63,16 @@ struct GnssConfig {
     double min_success_rate = 0.999;
     double elevation_mask_deg = 15.0;
     bool partial = true;
-    int min_ambiguities = 4;
+    int min_ambiguities = 6;
     int min_lock_epochs = 3;
     bool hold = false;
     int hold_min_epochs = 5;
     double hold_sigma_cycles = 0.01;
     double validation_w = 4.0;
     bool glonass = false;
+    /// off | search: GLONASS integers for receivers of different types, their inter-frequency phase bias rate found
+    /// by search (docs/carrier.md eqs. 3.9-3.11); ignored with glonass: true.
+    std::string glonass_ifb = "off";
   } ambiguity;
 };
 

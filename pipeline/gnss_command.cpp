@@ -61,6 +61,16 @@ Expected<void> check_nav_covers(const gnss::NavData& nav, const gnss::ObsData& r
 
 std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.4f}", v) : "null"; }
 
+// summary.json `carrier.glonass_ifb` (docs/carrier.md eq. 3.11), only with gnss.ambiguity.glonass_ifb: search.
+std::string glonass_ifb_json(const GnssRunSummary& s, const RunConfig& c) {
+  if (c.gnss.ambiguity.glonass_ifb != "search" || c.gnss.ambiguity.glonass) return "";
+  const auto& r = s.rtk;
+  return fmt::format(", \"glonass_ifb\": {{\"m_per_channel\": {}, \"found_s\": {}, \"searches\": {}, \"votes\": {}}}",
+                     r.glonass_ifb_m_per_channel ? fmt::format("{:.5f}", *r.glonass_ifb_m_per_channel) : "null",
+                     r.glonass_ifb_found_s ? json_number(*r.glonass_ifb_found_s) : "null", r.glonass_ifb_searches,
+                     r.glonass_ifb_votes);
+}
+
 std::string summary_json(const GnssRunSummary& s, const RunConfig& c) {
   std::string j = "{\n";
   j += fmt::format("  \"mode\": \"{}\",\n", s.differential ? "single_difference" : "undifferenced");
@@ -108,11 +118,11 @@ std::string summary_json(const GnssRunSummary& s, const RunConfig& c) {
         "  \"carrier\": {{\"used\": true, \"epochs\": {}, \"fixed\": {}, \"float\": {}, \"code\": {}, \"none\": {}, "
         "\"fix_rate_pct\": {}, \"time_to_first_fix_s\": {}, \"fix_attempts\": {}, \"not_fixed\": {}, "
         "\"fixes_rejected_by_validation\": {}, \"wrong_fix_detections\": {}, \"holds\": {}, \"slips\": {}, "
-        "\"code_rows_excluded\": {}, \"doppler_rows_excluded\": {}}},\n",
+        "\"code_rows_excluded\": {}, \"doppler_rows_excluded\": {}{}}},\n",
         r.epochs, r.fixed, r.float_, r.code, r.none, json_number(r.epochs ? 100.0 * r.fixed / r.epochs : 0.0),
         r.time_to_first_fix_s ? json_number(*r.time_to_first_fix_s) : "null", r.fix_attempts, map_json(r.not_fixed),
         r.fixes_rejected_by_validation, r.wrong_fix_detections, r.holds, slips, r.code_rows_excluded,
-        r.doppler_rows_excluded);
+        r.doppler_rows_excluded, glonass_ifb_json(s, c));
   }
   if (s.tdcp) {
     const auto& t = s.tdcp_summary;

@@ -90,6 +90,7 @@ fusion::AmbiguityOptions ambiguity_options(const GnssConfig& g) {
   o.hold_sigma_cycles = a.hold_sigma_cycles;
   o.validation_w = a.validation_w;
   o.glonass = a.glonass;
+  o.glonass_ifb_search = a.glonass_ifb == "search";
   return o;
 }
 

@@ -48,6 +48,14 @@ Problem make_problem(double sigma_cycles, uint32_t seed) {
   return p;
 }
 
+// The options of these tests: the defaults but 4 double differences at least (the problem has 6 satellites: 5 DD;
+// the default of 6 is tested on its own below).
+AmbiguityOptions opts() {
+  AmbiguityOptions o;
+  o.min_ambiguities = 4;
+  return o;
+}
+
 // The fixed DD integers against the truth: D sd_int.
 bool fixed_right(const AmbiguityFix& f, const Problem& p) {
   Eigen::VectorXd full = Eigen::VectorXd::Zero(p.x.size());
@@ -57,7 +65,7 @@ bool fixed_right(const AmbiguityFix& f, const Problem& p) {
 
 TEST(Ambiguity, StrongFloatFixesTheRightIntegers) {
   const Problem p = make_problem(0.03, 1);
-  const AmbiguityFix f = resolve_ambiguities(p.x, p.P, p.cands, AmbiguityOptions{});
+  const AmbiguityFix f = resolve_ambiguities(p.x, p.P, p.cands, opts());
   ASSERT_TRUE(f.fixed) << f.why_not;
   EXPECT_EQ(f.D.rows(), 5);  // one constellation of 6: 5 DD against the highest
   EXPECT_TRUE(fixed_right(f, p));
@@ -67,7 +75,7 @@ TEST(Ambiguity, StrongFloatFixesTheRightIntegers) {
 
 TEST(Ambiguity, WeakFloatIsRefused) {
   const Problem p = make_problem(0.6, 2);
-  AmbiguityOptions o;
+  AmbiguityOptions o = opts();
   o.partial = false;
   const AmbiguityFix f = resolve_ambiguities(p.x, p.P, p.cands, o);
   EXPECT_FALSE(f.fixed);
@@ -84,10 +92,10 @@ TEST(Ambiguity, PartialResolutionDropsTheSpoilingSatellite) {
   p.P.col(low).setZero();
   p.P(low, low) = 4.0;
   p.x(low) = p.sd_int(5) + 0.5 + p.x(3) - p.sd_int(0);  // half a cycle off in the DD
-  AmbiguityOptions full;
+  AmbiguityOptions full = opts();
   full.partial = false;
   EXPECT_FALSE(resolve_ambiguities(p.x, p.P, p.cands, full).fixed);
-  const AmbiguityFix f = resolve_ambiguities(p.x, p.P, p.cands, AmbiguityOptions{});
+  const AmbiguityFix f = resolve_ambiguities(p.x, p.P, p.cands, opts());
   ASSERT_TRUE(f.fixed) << f.why_not;
   EXPECT_EQ(f.D.rows(), 4);
   EXPECT_TRUE(fixed_right(f, p));
@@ -100,15 +108,26 @@ TEST(Ambiguity, GlonassYoungAndLowAmbiguitiesStayFloat) {
   p.cands[1].integer = false;
   p.cands[2].lock_epochs = 1;                 // below min_lock_epochs = 3
   p.cands[3].elevation_rad = 10.0 * kDegToRad;  // below the 15° AR mask
-  const AmbiguityFix f = resolve_ambiguities(p.x, p.P, p.cands, AmbiguityOptions{});
+  const AmbiguityFix f = resolve_ambiguities(p.x, p.P, p.cands, opts());
   EXPECT_EQ(f.n_candidates, 2);  // 3 GPS candidates left → 2 DD, below min_ambiguities = 4
   EXPECT_FALSE(f.fixed);
   EXPECT_EQ(f.why_not, "too_few_ambiguities");
 }
 
+// The default set size (docs/carrier.md §3): fewer than 6 double differences are not fixed, however strong the float.
+TEST(Ambiguity, TheDefaultNeedsSixDoubleDifferences) {
+  const Problem p = make_problem(0.03, 1);
+  EXPECT_EQ(AmbiguityOptions{}.min_ambiguities, 6);
+  const AmbiguityFix f = resolve_ambiguities(p.x, p.P, p.cands, AmbiguityOptions{});
+  EXPECT_FALSE(f.fixed);
+  EXPECT_EQ(f.n_candidates, 5);
+  EXPECT_EQ(f.why_not, "too_few_ambiguities");
+  EXPECT_TRUE(resolve_ambiguities(p.x, p.P, p.cands, opts()).fixed);
+}
+
 TEST(Ambiguity, ConditioningIsTheExactConditional) {
   const Problem p = make_problem(0.03, 5);
-  const AmbiguityFix f = resolve_ambiguities(p.x, p.P, p.cands, AmbiguityOptions{});
+  const AmbiguityFix f = resolve_ambiguities(p.x, p.P, p.cands, opts());
   ASSERT_TRUE(f.fixed);
   Eigen::VectorXd x = p.x;
   Eigen::MatrixXd P = p.P;
@@ -123,7 +142,7 @@ TEST(Ambiguity, ConditioningIsTheExactConditional) {
 
 TEST(Ambiguity, HoldWithSigmaLeavesThatVariance) {
   const Problem p = make_problem(0.03, 6);
-  const AmbiguityFix f = resolve_ambiguities(p.x, p.P, p.cands, AmbiguityOptions{});
+  const AmbiguityFix f = resolve_ambiguities(p.x, p.P, p.cands, opts());
   ASSERT_TRUE(f.fixed);
   Eigen::VectorXd x = p.x;
   Eigen::MatrixXd P = p.P;
