@@ -505,7 +505,7 @@ TEST(GnssRtkData, GalwayStaticSessionFixes) {
 // GLONASS phases differ by an inter-frequency bias β k, so GLONASS can be fixed only once β is known; with
 // gnss.ambiguity.glonass_ifb: search it is found (docs/carrier.md eqs. 3.9-3.11). Scored against the receiver's fixed
 // GGA epochs after removing the mean offset of the fixed epochs (the receiver's RTK frame is ≈ 1.2 m from GLW1's).
-// Measured 2026-12-06 (held out: nothing was chosen on GLW1): β = −0.0525 m per channel after 56 s (10 votes in 55
+// Measured 2026-12-06 (GLW1 was looked at when the search's constants were set: docs/carrier.md §7): β = −0.0525 m per channel after 56 s (10 votes in 55
 // searches); 617 of 1179 epochs fixed (52 %), 0 of 375 scored wrong, 0.013 m RMS on fixed, offset −0.41 m east,
 // −1.14 m north; without the search 0 fixed (GPS alone never has the 6 double differences). Bounds: fixed −5 %,
 // wrong the 1 %, RMS +20 %, β ± one grid step.
