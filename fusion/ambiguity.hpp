@@ -35,9 +35,10 @@ struct AmbiguityOptions {
   /// GLONASS SD ambiguities [cycles of each channel] are resolved as integers too: valid when the rover and the base
   /// are receivers of one type (their inter-frequency phase biases cancel), RTKLIB's `pos2-gloarmode = on`.
   bool glonass = false;
-  /// GLONASS integers for receivers of different types: the inter-frequency phase bias rate β is searched (eqs.
-  /// 3.9-3.11, fusion/glonass_ifb) and, once found, removed before GLONASS is resolved as integers.
-  bool glonass_ifb_search = false;
+  /// GLONASS integers for any receiver pair: the inter-frequency phase bias rate β is searched (eqs. 3.9-3.11,
+  /// fusion/glonass_ifb; 0 for two receivers of one type) and, once found, removed before GLONASS is resolved as
+  /// integers. `pednav gnss` only (the tight coupling keeps GLONASS float unless `glonass`).
+  bool glonass_ifb_search = true;
 };
 
 /// One SD ambiguity state offered for resolution.

@@ -70,9 +70,9 @@ struct GnssConfig {
     double hold_sigma_cycles = 0.01;
     double validation_w = 4.0;
     bool glonass = false;
-    /// off | search: GLONASS integers for receivers of different types, their inter-frequency phase bias rate found
-    /// by search (docs/carrier.md eqs. 3.9-3.11); ignored with glonass: true.
-    std::string glonass_ifb = "off";
+    /// search | off: GLONASS integers once the inter-frequency phase bias rate of the receiver pair has been found by
+    /// search (docs/carrier.md eqs. 3.9-3.11; 0 for two receivers of one type); ignored with glonass: true.
+    std::string glonass_ifb = "search";
   } ambiguity;
 };
 

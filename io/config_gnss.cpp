@@ -59,7 +59,7 @@ void read_gnss_section(YamlMap& top, GnssConfig& out) {
   a.number("hold_sigma_cycles", o.hold_sigma_cycles, false, 0.0001, 1.0);
   a.number("validation_w", o.validation_w, false, 1.0, 100.0);
   a.boolean("glonass", o.glonass);
-  a.choice("glonass_ifb", o.glonass_ifb, {"off", "search"});
+  a.choice("glonass_ifb", o.glonass_ifb, {"search", "off"});
   a.finish();
 }
 

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -61,9 +62,14 @@ Expected<void> check_nav_covers(const gnss::NavData& nav, const gnss::ObsData& r
 
 std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.4f}", v) : "null"; }
 
-// summary.json `carrier.glonass_ifb` (docs/carrier.md eq. 3.11), only with gnss.ambiguity.glonass_ifb: search.
+// summary.json `carrier.glonass_ifb` (docs/carrier.md eq. 3.11): with GLONASS, gnss.ambiguity.glonass_ifb: search
+// (the default) and glonass: false.
 std::string glonass_ifb_json(const GnssRunSummary& s, const RunConfig& c) {
-  if (c.gnss.ambiguity.glonass_ifb != "search" || c.gnss.ambiguity.glonass) return "";
+  const auto& sys = c.gnss.systems;
+  if (c.gnss.ambiguity.glonass_ifb != "search" || c.gnss.ambiguity.glonass ||
+      std::find(sys.begin(), sys.end(), "R") == sys.end()) {
+    return "";
+  }
   const auto& r = s.rtk;
   return fmt::format(", \"glonass_ifb\": {{\"m_per_channel\": {}, \"found_s\": {}, \"searches\": {}, \"votes\": {}}}",
                      r.glonass_ifb_m_per_channel ? fmt::format("{:.5f}", *r.glonass_ifb_m_per_channel) : "null",
