@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <optional>
 
 #include "eval/statistics.hpp"
 #include "eval/trajectory.hpp"
@@ -149,6 +151,28 @@ TEST(GalwayTrack, TightlyCoupledOnTheRealGnssAgainstRtkFixed) {
   EXPECT_GE(in_s, kMinSmoothedInside3SigmaPct);
 }
 
+// galway_track simulated into a fresh folder and run in mode tc with `edit` applied to its written config.yaml.
+std::optional<fusion::EngineResult> run_galway_track(const std::string& name,
+                                                      const std::function<void(io::RunConfig&)>& edit) {
+  auto sc = io::load_scenario(test::source_path("datasets/galway_track.yaml"));
+  EXPECT_TRUE(sc.has_value()) << (sc ? "" : sc.error().message);
+  if (!sc) return std::nullopt;
+  const std::string dir = test::temp_dir(name);
+  if (!pipeline::run_simulate_command(*sc, dir).has_value()) return std::nullopt;
+  auto cfg = io::load_run_config(dir + "/config.yaml");
+  EXPECT_TRUE(cfg.has_value()) << (cfg ? "" : cfg.error().message);
+  if (!cfg) return std::nullopt;
+  cfg->mode = "tc";
+  edit(*cfg);
+  auto data = pipeline::load_run_inputs(*cfg);
+  EXPECT_TRUE(data.has_value()) << (data ? "" : data.error().message);
+  if (!data) return std::nullopt;
+  auto r = fusion::run_forward(data->engine_inputs(), data->options);
+  EXPECT_TRUE(r.has_value()) << (r ? "" : r.error().message);
+  if (!r) return std::nullopt;
+  return std::move(*r);
+}
+
 // Carrier phase in the tight coupling on the real Galway walk (issue 48, docs/carrier.md §8): `pednav run` with
 // gnss.carrier: on and the peer configuration of ../shared/notes/rtk_peer_galway.md (G+R, 15°, 35 dB-Hz; rover and
 // base are both M8P, so GLONASS is fixed too), scored on the antenna output (antenna.csv) against the receiver's
@@ -165,22 +189,14 @@ constexpr double kRmsOnFixed_m = 0.012, kForwardRms_m = 0.293, kSmoothedRms_m = 
 TEST(GalwayTrack, CarrierInTheTightCouplingFixesTheRealPhase) {
   const std::string nmea = test::shared_data("gnss_ublox_m8p_walk_galway/reference_nmea/rover-20181004-1532.nmea");
   PEDNAV_REQUIRE_DATA(nmea);
-  auto sc = io::load_scenario(test::source_path("datasets/galway_track.yaml"));
-  ASSERT_TRUE(sc.has_value()) << (sc ? "" : sc.error().message);
-  const std::string dir = test::temp_dir("galway_track_carrier");
-  ASSERT_TRUE(pipeline::run_simulate_command(*sc, dir).has_value());
-  auto cfg = io::load_run_config(dir + "/config.yaml");
-  ASSERT_TRUE(cfg.has_value()) << (cfg ? "" : cfg.error().message);
-  cfg->mode = "tc";
-  cfg->gnss.carrier = "on";
-  cfg->gnss.systems = {"G", "R"};
-  cfg->gnss.elevation_mask_rad = 15.0 * kDegToRad;
-  cfg->gnss.min_cn0_dbhz = 35.0;
-  cfg->gnss.ambiguity.glonass = true;
-  auto data = pipeline::load_run_inputs(*cfg);
-  ASSERT_TRUE(data.has_value()) << (data ? "" : data.error().message);
-  auto r = fusion::run_forward(data->engine_inputs(), data->options);
-  ASSERT_TRUE(r.has_value()) << (r ? "" : r.error().message);
+  const auto r = run_galway_track("galway_track_carrier", [](io::RunConfig& c) {
+    c.gnss.carrier = "on";
+    c.gnss.systems = {"G", "R"};
+    c.gnss.elevation_mask_rad = 15.0 * kDegToRad;
+    c.gnss.min_cn0_dbhz = 35.0;
+    c.gnss.ambiguity.glonass = true;
+  });
+  ASSERT_TRUE(r.has_value());
   ASSERT_TRUE(r->summary.smoothed);
 
   io::TrajectoryReadOptions fixed;
@@ -245,19 +261,11 @@ TEST(GalwayTrack, CarrierInTheTightCouplingFixesTheRealPhase) {
 TEST(GalwayTrack, GlonassCodeBiasesAreCorrelatedErrors) {
   const std::string nmea = test::shared_data("gnss_ublox_m8p_walk_galway/reference_nmea/rover-20181004-1532.nmea");
   PEDNAV_REQUIRE_DATA(nmea);
-  auto sc = io::load_scenario(test::source_path("datasets/galway_track.yaml"));
-  ASSERT_TRUE(sc.has_value()) << (sc ? "" : sc.error().message);
-  const std::string dir = test::temp_dir("galway_track_glonass");
-  ASSERT_TRUE(pipeline::run_simulate_command(*sc, dir).has_value());
-  auto cfg = io::load_run_config(dir + "/config.yaml");
-  ASSERT_TRUE(cfg.has_value()) << (cfg ? "" : cfg.error().message);
-  cfg->mode = "tc";
-  cfg->gnss.systems = {"G", "R"};
-  cfg->smoother_enabled = false;
-  auto data = pipeline::load_run_inputs(*cfg);
-  ASSERT_TRUE(data.has_value()) << (data ? "" : data.error().message);
-  auto r = fusion::run_forward(data->engine_inputs(), data->options);
-  ASSERT_TRUE(r.has_value()) << (r ? "" : r.error().message);
+  const auto r = run_galway_track("galway_track_glonass", [](io::RunConfig& c) {
+    c.gnss.systems = {"G", "R"};
+    c.smoother_enabled = false;
+  });
+  ASSERT_TRUE(r.has_value());
   io::TrajectoryReadOptions fixed;
   fixed.nmea_qualities = {4};
   auto ref = io::read_trajectory(nmea, fixed);
