@@ -46,6 +46,20 @@ TEST(Config, DuplicateKeyIsAnErrorNamingBothLines) {
   EXPECT_THAT(nested.error().message, HasSubstr("cfg.yaml:6: gnss.min_cn0_dbhz: duplicate key (first at line 5)"));
 }
 
+// gnss.ambiguity.glonass_ifb (docs/carrier.md §3.1): search by default, off accepted, anything else named with its line.
+TEST(Config, GlonassIfbIsSearchOrOff) {
+  auto def = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\n");
+  ASSERT_TRUE(def) << def.error().message;
+  EXPECT_EQ(def->gnss.ambiguity.glonass_ifb, "search");
+  auto off = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\ngnss:\n  ambiguity: {glonass_ifb: off}\n");
+  ASSERT_TRUE(off) << off.error().message;
+  EXPECT_EQ(off->gnss.ambiguity.glonass_ifb, "off");
+  auto bad = parse("mode: gnss\nrover_obs: r.obs\nnav: n.nav\ngnss:\n  ambiguity:\n    glonass_ifb: calibrate\n");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message,
+              HasSubstr("cfg.yaml:6: gnss.ambiguity.glonass_ifb: expected one of {search, off}, got 'calibrate'"));
+}
+
 TEST(Config, WrongTypeNegativeRateAndBadEnumAreAllReportedAtOnce) {
   auto cfg = parse(
       "mode: gnss\nrover_obs: r.obs\nnav: n.nav\nmechanization_rate_hz: -5\n"

@@ -101,6 +101,26 @@ TEST(RunWarnings, StepsTooLongForAWalk) {
   EXPECT_EQ(ws[0].limit, 2.0);
 }
 
+// A 1-Hz output (GNSS epochs) catches a stance now and then: the distance between two caught ones is any number of
+// strides, so the step and cadence checks do not run on it (docs/fusion.md §15.3-15.4); with the interval limit
+// lifted the same output warns of 3-m steps at 0.2 strides/s (a caught stance every 4-5 s) that never happened.
+TEST(RunWarnings, CoarseOutputsSkipTheStepAndCadenceChecks) {
+  Walk w;
+  w.rate_hz = 1.0;
+  w.stride_s = 1.25;  // stances at 0, 1.25, 2.5, …: a 1-Hz epoch falls in one every 4-5 s (4-5 strides)
+  w.stance_s = 0.4;
+  w.duration_s = 300.0;
+  const fusion::EngineResult r = walk(w);
+  EXPECT_TRUE(run_warnings(r, spec()).empty());
+  RunWarningLimits lifted;
+  lifted.gait_output_interval_max_s = 10.0;
+  lifted.max_stride_s = 10.0;
+  const auto ws = run_warnings(r, spec(), lifted);
+  ASSERT_EQ(codes(ws), (std::vector<std::string>{"step_length", "cadence"}));
+  EXPECT_NEAR(ws[0].value, 3.0, 0.01);
+  EXPECT_NEAR(ws[1].value, 0.2, 0.01);
+}
+
 TEST(RunWarnings, CadenceThatNoGaitHas) {
   Walk w;
   w.stride_s = 0.4;   // 2.5 strides/s
