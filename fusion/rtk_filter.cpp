@@ -408,7 +408,7 @@ RtkEpoch RtkFilter::process(const gnss::ObsEpoch& rover, int base_index) {
   }
   if (!cands.empty() && x_.size() > n_before_amb) {
     ++sum_.fix_attempts;
-    // GLONASS of a receiver of another type (eqs. 3.9-3.11): search β while it is unknown, then resolve with it removed.
+    // GLONASS inter-frequency bias rate β (eqs. 3.9-3.11): searched while unknown, then removed before the resolution.
     if (o_.ar.glonass_ifb_search && !o_.ar.glonass && !ifb_.beta_m()) {
       if (ifb_.search(x_, P_, cands, o_.ar)) {
         sum_.glonass_ifb_m_per_channel = ifb_.beta_m();

@@ -232,8 +232,8 @@ Expected<StridePlan> plan_track(const Scenario& sc, const LocalFrame& frame) {
   if (sc.track.size() < 2) return make_error("track: at least 2 points are needed");
   const GpsTime t0 = sc.start;
   // Ground track smoothed with a Gaussian kernel on a 0.5 s grid: RTK float epochs jitter, and a wider kernel cuts the
-  // corners (sigma 1 s put the simulated antenna 0.10 m RMS, 0.84 m at most, off the fixed Galway epochs; 0.5 s: 0.03 m,
-  // 0.29 m), which puts the foot IMU off the track the real carrier phase measures (docs/sim.md §1).
+  // corners (sigma 1 s put the simulated antenna 0.10 m RMS, 0.84 m at most, off the fixed Galway epochs; 0.5 s:
+  // 0.03 m, 0.29 m), which puts the foot IMU off the track the real carrier phase measures (docs/sim.md §3).
   constexpr double kKernelSigma_s = 0.5;
   const double span = sc.track.back().t - t0;
   if (!(span > 10.0)) return make_error("track: it ends less than 10 s after the scenario start");
@@ -289,7 +289,8 @@ Expected<StridePlan> plan_track(const Scenario& sc, const LocalFrame& frame) {
     // Every stride lands on the track, turning by at most max_turn_per_stride (a sharper corner of the track is taken
     // over several strides that keep up with it: in-place turning strides would leave the antenna metres ahead).
     const double y_track = moving ? heading_of(v) : pl.yaw;
-    const double turn = std::clamp(wrap_pi(y_track - pl.yaw), -sc.gait.max_turn_per_stride_rad, sc.gait.max_turn_per_stride_rad);
+    const double max_turn = sc.gait.max_turn_per_stride_rad;
+    const double turn = std::clamp(wrap_pi(y_track - pl.yaw), -max_turn, max_turn);
     pl.stride(g, wrap_pi(pl.yaw + turn), false, 0.0);
   }
   // The body follows the smoothed track itself (the antenna's truth).
