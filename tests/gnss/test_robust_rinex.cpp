@@ -10,6 +10,7 @@
 #include <string>
 
 #include "gnss/rtklib/rinex.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace pednav::gnss {
 namespace {
@@ -52,8 +53,14 @@ const std::string kObs =
     "E11  20126456.789   105789459.123 7     -1231.567          42.000  \n"
     "C30  20127456.789   105789460.123 7     -1230.567          41.000  \n";
 
+// This process's temporary folder, made once.
+const std::string& kTempDir() {
+  static const std::string dir = test::temp_dir("robust_rinex");
+  return dir;
+}
+
 std::string write(const std::string& name, const std::string& text) {
-  const std::string p = (std::filesystem::temp_directory_path() / ("pednav_robust_" + name)).string();
+  const std::string p = (std::filesystem::path(kTempDir()) / name).string();
   std::ofstream(p, std::ios::binary) << text;
   return p;
 }
@@ -80,7 +87,7 @@ TEST(RobustRinexFuzzFinding, ObservationEpochOutsideRtklibsYearRangeIsDroppedAnd
   text.replace(text.find("> 2024"), 6, "> 2150");  // RTKLIB: 1970-01-01, before the GPS epoch
   auto bad = read_rinex_obs(write("year.obs", text), all);
   ASSERT_FALSE(bad);
-  EXPECT_THAT(bad.error().message, HasSubstr("pednav_robust_year.obs: no usable observation epoch"));
+  EXPECT_THAT(bad.error().message, HasSubstr("/year.obs: no usable observation epoch"));
 }
 
 TEST(RobustRinexFuzzFinding, OutOfRangeSnrFieldIsNotAMemoryError) {

@@ -16,6 +16,7 @@
 #include "io/config.hpp"
 #include "io/imu_csv.hpp"
 #include "tests/support/data.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace pednav {
 namespace {
@@ -52,8 +53,14 @@ std::vector<size_t> cuts_in(const std::string& text, size_t from) {
   return c;
 }
 
+// This process's temporary folder, made once.
+const std::string& kTempDir() {
+  static const std::string dir = test::temp_dir("robust_data");
+  return dir;
+}
+
 std::string write_cut(const std::string& name, const std::string& text, size_t cut) {
-  const std::string p = (std::filesystem::temp_directory_path() / ("pednav_robust_data_" + name)).string();
+  const std::string p = (std::filesystem::path(kTempDir()) / name).string();
   std::ofstream(p, std::ios::binary) << text.substr(0, cut);
   return p;
 }

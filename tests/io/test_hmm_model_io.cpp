@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "io/atomic_file.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace pednav::io {
 namespace {
@@ -16,7 +17,7 @@ namespace {
 using ::testing::HasSubstr;
 
 std::string temp_path(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "pednav_test_hmm_model_io";
+  const auto dir = test::temp_dir_path("hmm_model_io");
   std::filesystem::create_directories(dir);
   return (dir / name).string();
 }

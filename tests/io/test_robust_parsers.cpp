@@ -19,6 +19,7 @@
 #include "io/imu_csv.hpp"
 #include "io/scenario_config.hpp"
 #include "io/trajectory_io.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace pednav::io {
 namespace {
@@ -259,10 +260,16 @@ TEST(RobustConfigFuzzFinding, NmeaQualitiesBeyondIntAreErrorsNamingTheKey) {
 }
 
 // Inputs found by fuzz/fuzz_trajectory (UBSan: signed overflow in the nanosecond count of a far-future date).
+// This process's temporary folder, made once.
+const std::string& kTempDir() {
+  static const std::string dir = test::temp_dir("robust_parsers");
+  return dir;
+}
+
 class RobustTrajectoryFuzzFinding : public ::testing::Test {
  protected:
   std::string write(const std::string& name, const std::string& text) {
-    const std::string p = (std::filesystem::temp_directory_path() / ("pednav_robust_" + name)).string();
+    const std::string p = (std::filesystem::path(kTempDir()) / name).string();
     std::ofstream(p, std::ios::binary) << text;
     return p;
   }
@@ -273,16 +280,16 @@ TEST_F(RobustTrajectoryFuzzFinding, PosWithAFarFutureYearIsAnError) {
                                           "2060000/03/05 12:00:00.000 53.28 -9.05 75.1 1 9\n");
   auto r = read_rtklib_pos(p);
   ASSERT_FALSE(r);
-  EXPECT_THAT(r.error().message, HasSubstr("robust_year.pos:2: expected 'YYYY/MM/DD HH:MM:SS.SSS' time"));
+  EXPECT_THAT(r.error().message, HasSubstr("/year.pos:2: expected 'YYYY/MM/DD HH:MM:SS.SSS' time"));
 }
 
 TEST_F(RobustTrajectoryFuzzFinding, PosAndCsvWithAnAbsurdWeekAreErrors) {
   auto pos = read_rtklib_pos(write("week.pos", "% GPST x-ecef(m) y-ecef(m) z-ecef(m)\n99999999999 1 3822100 -609600 5083000 1 8\n"));
   ASSERT_FALSE(pos);
-  EXPECT_THAT(pos.error().message, HasSubstr("robust_week.pos:2: expected 'week tow' or a calendar time"));
+  EXPECT_THAT(pos.error().message, HasSubstr("/week.pos:2: expected 'week tow' or a calendar time"));
   auto csv = read_trajectory_csv(write("week.csv", "gps_week,gps_tow_s,x_m,y_m,z_m\n1e15,0,1,2,3\n"));
   ASSERT_FALSE(csv);
-  EXPECT_THAT(csv.error().message, HasSubstr("robust_week.csv:2: time (GPS week 1000000000000000, 0 s) is out of range"));
+  EXPECT_THAT(csv.error().message, HasSubstr("/week.csv:2: time (GPS week 1000000000000000, 0 s) is out of range"));
 }
 
 TEST_F(RobustTrajectoryFuzzFinding, CsvWithGpsWeekButNoGpsTowColumnUsesTheOtherTimeColumns) {

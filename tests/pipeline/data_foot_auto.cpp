@@ -18,6 +18,7 @@
 #include "pipeline/compare_command.hpp"
 #include "pipeline/run_command.hpp"
 #include "tests/support/data.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace pednav::pipeline {
 namespace {
@@ -74,7 +75,7 @@ std::vector<Trial> read_trials() {
 }
 
 std::filesystem::path fresh_dir_path(const std::string& name) {
-  return std::filesystem::temp_directory_path() / ("pednav_data_foot_auto_" + name);
+  return test::temp_dir_path("data_foot_auto_" + name);
 }
 
 std::filesystem::path fresh_dir(const std::string& name) {

@@ -21,6 +21,7 @@
 #include "io/config.hpp"
 #include "pipeline/run_command.hpp"
 #include "tests/support/data.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace pednav::pipeline {
 namespace {
@@ -89,7 +90,7 @@ constexpr PyshoeMeasured kPyshoeMeasured[] = {
 constexpr double kLordFastWalkRms_m = 1.2031;
 
 std::filesystem::path temp_dir(const std::string& name) {
-  const auto d = std::filesystem::temp_directory_path() / ("pednav_data_foot_ins_" + name);
+  const auto d = test::temp_dir_path("data_foot_ins_" + name);
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
   return d;

@@ -22,6 +22,7 @@
 #include "io/config.hpp"
 #include "pipeline/run_command.hpp"
 #include "tests/support/data.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace pednav::pipeline {
 namespace {
@@ -57,7 +58,7 @@ LogFigures run_log(const std::string& n) {
   cfg->initial.yaw_rad.reset();
   cfg->initial.heading_from_magnetometer = true;
   cfg->initial.declination_rad = 0.0;  // the hallway's location is not documented: magnetic azimuths
-  const auto out = std::filesystem::temp_directory_path() / ("pednav_data_lord_mag_" + n);
+  const auto out = test::temp_dir_path("data_lord_mag_" + n);
   std::filesystem::remove_all(out);
   auto sum = run_run_command(*cfg, out.string());
   EXPECT_TRUE(sum) << n << ": " << sum.error().message;

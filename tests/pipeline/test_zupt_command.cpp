@@ -13,6 +13,7 @@
 
 #include "io/config.hpp"
 #include "pipeline/zupt_command.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace pednav::pipeline {
 namespace {
@@ -56,7 +57,7 @@ Expected<ZuptCommandSummary> run(const std::filesystem::path& dir, const std::fi
 }
 
 TEST(ZuptCommand, DetectorScoredAgainstTheLogsStanceLabels) {
-  const auto dir = std::filesystem::temp_directory_path() / "pednav_test_zupt_command";
+  const auto dir = test::temp_dir_path("zupt_command");
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const auto labelled = write_log(dir, false), inverted = write_log(dir, true);

@@ -18,6 +18,7 @@
 #include "pipeline/run_command.hpp"
 #include "io/scenario_config.hpp"
 #include "sim/simulator.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace pednav::test {
 
@@ -98,36 +99,6 @@ inline fusion::EngineOptions tc_default_options(const io::ScenarioFile& file, co
   fusion::EngineOptions o = pipeline::engine_options(c);
   o.base_position_e = s.gnss.p_base_e;
   return o;
-}
-
-/// The temporary folders of this test process, removed when it exits (a test run would otherwise leave ~0.9 GB in
-/// the temporary directory); PEDNAV_KEEP_TEST_DIRS=1 keeps them to look at a failure.
-class TempDirRegistry {
- public:
-  void add(const std::filesystem::path& p) { dirs_.push_back(p); }
-  ~TempDirRegistry() {
-    const char* keep = std::getenv("PEDNAV_KEEP_TEST_DIRS");
-    if (keep && std::string(keep) == "1") return;
-    std::error_code ec;
-    for (const auto& d : dirs_) std::filesystem::remove_all(d, ec);
-  }
-
- private:
-  std::vector<std::filesystem::path> dirs_;
-};
-
-inline TempDirRegistry& temp_dir_registry() {
-  static TempDirRegistry registry;
-  return registry;
-}
-
-/// A fresh empty temporary folder, removed when the test process exits.
-inline std::string temp_dir(const std::string& name) {
-  const auto p = std::filesystem::temp_directory_path() / ("pednav_test_" + name + "_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(p);
-  std::filesystem::create_directories(p);
-  temp_dir_registry().add(p);
-  return p.string();
 }
 
 inline std::string read_text(const std::string& path) {
