@@ -5,13 +5,13 @@
 #include <fstream>
 
 #include "io/atomic_file.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace pednav::io {
 namespace {
 
 std::filesystem::path temp_dir() {
-  auto d = std::filesystem::temp_directory_path() / ("pednav_atomic_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
-  std::filesystem::create_directories(d);
+  static const std::filesystem::path d = test::temp_dir("atomic_file");
   return d;
 }
 
