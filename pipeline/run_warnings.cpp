@@ -52,18 +52,12 @@ void check_disagreement(const fusion::EngineResult& r, const RunWarningLimits& l
   if (n < l.disagreement_min_epochs) return;
   const double share = static_cast<double>(beyond) / n;
   if (share <= l.disagreement_max_share) return;
-  // With GNSS rows the forward σ can also be too small for GNSS errors the model does not have (a code fault the
-  // w-test passed, reflections under canopy): the hint names both models.
-  const bool gnss = std::any_of(r.epochs.begin(), r.epochs.end(), [](const auto& e) { return e.n_sats_used > 0; });
   out.push_back({"forward_smoothed_disagree",
                  fmt::format("forward and smoothed positions differ beyond their σ's at {:.1f} % of {} epochs "
                              "(1 % expected; limit {:.0f} %)", 100.0 * share, n, 100.0 * l.disagreement_max_share),
                  100.0 * share, 100.0 * l.disagreement_max_share,
-                 gnss ? "the filter's IMU or GNSS error model does not fit this run: look for code faults and large "
-                        "w-test values in residuals.csv where the two solutions part; for the IMU try imu.spec: auto "
-                        "(or pednav calibrate), and check imu.format's units, axes and rate"
-                      : "the filter's IMU model does not fit this sensor: try imu.spec: auto (or pednav calibrate), "
-                        "and check imu.format's units, axes and rate"});
+                 "the filter's IMU model does not fit this sensor: try imu.spec: auto (or pednav calibrate), and "
+                 "check imu.format's units, axes and rate"});
 }
 
 // Stances of the forward output: mean position and mid time of each run of ZUPT epochs.

@@ -11,7 +11,6 @@ namespace pednav::pipeline {
 namespace {
 
 using ::testing::HasSubstr;
-using ::testing::Not;
 
 struct Walk {
   double speed_mps = 1.2;     // along north
@@ -81,21 +80,6 @@ TEST(RunWarnings, ForwardAndSmoothedApartBeyondTheirSigmas) {
   EXPECT_THAT(ws[0].hint, HasSubstr("imu.spec: auto"));
   const auto j = run_warnings_json(ws);
   EXPECT_EQ(j[0]["code"], "forward_smoothed_disagree");
-}
-
-TEST(RunWarnings, WithGnssRowsTheDisagreementHintNamesTheGnssModelToo) {
-  Walk w;
-  w.smoothed_offset_m = 1.0;
-  fusion::EngineResult r = walk(w);
-  const auto ins_only = run_warnings(r, spec());
-  ASSERT_EQ(codes(ins_only), std::vector<std::string>{"forward_smoothed_disagree"});
-  EXPECT_THAT(ins_only[0].hint, Not(HasSubstr("GNSS")));
-  r.epochs[r.epochs.size() / 2].n_sats_used = 8;  // a tight-coupling run: GNSS rows at some epoch
-  const auto tc = run_warnings(r, spec());
-  ASSERT_EQ(codes(tc), std::vector<std::string>{"forward_smoothed_disagree"});
-  EXPECT_THAT(tc[0].hint, HasSubstr("IMU or GNSS error model"));
-  EXPECT_THAT(tc[0].hint, HasSubstr("residuals.csv"));
-  EXPECT_EQ(tc[0].message, ins_only[0].message);
 }
 
 TEST(RunWarnings, NoStancesOnAMovingTrack) {
