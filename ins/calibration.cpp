@@ -22,9 +22,10 @@ double percentile(std::vector<double> v, double p) {
   return v[k];
 }
 
-std::string format(const char* f, double a, double b = 0.0, double c = 0.0) {
-  char buf[320];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
+template <typename... Args>
+std::string format(const char* f, Args... args) {
+  char buf[400];
+  std::snprintf(buf, sizeof buf, f, args...);
   return buf;
 }
 
@@ -33,6 +34,42 @@ struct Moments {
   Vector3d mean_w = Vector3d::Zero(), var_w = Vector3d::Zero();
   Vector3d mean_f = Vector3d::Zero(), var_f = Vector3d::Zero();
 };
+// The rate of the unit specific force over samples [b, e) against the rate the mean gyro reading mean_w would turn it
+// at (docs/ins.md eq. 10.2), into the calibration's bias_window_* fields.
+void window_rotation(const std::vector<ImuSample>& s, size_t b, size_t e, const Vector3d& mean_w,
+                     const CalibrationOptions& o, ImuCalibration& c) {
+  const double n = static_cast<double>(e - b);
+  if (e - b < 3) return;
+  double t_mean = 0.0;
+  Vector3d u_mean = Vector3d::Zero();
+  for (size_t i = b; i < e; ++i) {
+    t_mean += (s[i].t - s[b].t) / n;
+    u_mean += s[i].f_ib_b.normalized() / n;
+  }
+  double stt = 0.0;
+  Vector3d stu = Vector3d::Zero();
+  for (size_t i = b; i < e; ++i) {
+    const double dt = (s[i].t - s[b].t) - t_mean;
+    stt += dt * dt;
+    stu += dt * (s[i].f_ib_b.normalized() - u_mean);
+  }
+  if (!(stt > 0.0)) return;
+  const Vector3d slope = stu / stt;  // ġ, least squares [1/s]
+  double rss = 0.0;
+  for (size_t i = b; i < e; ++i) {
+    const double dt = (s[i].t - s[b].t) - t_mean;
+    rss += (s[i].f_ib_b.normalized() - u_mean - slope * dt).squaredNorm();
+  }
+  const double sd = std::sqrt(rss / (3.0 * (n - 2.0)) / stt);
+  // A direction fixed in the navigation frame seen from sensor axes turning at ω: u̇ = u × ω.
+  const Vector3d p = u_mean.normalized().cross(mean_w);
+  c.bias_window_tilt_rate_radps = slope.norm();
+  c.bias_window_predicted_rate_radps = p.norm();
+  c.bias_window_tilt_rate_sd_radps = sd;
+  c.bias_window_rotation_k = p.squaredNorm() > 0.0 ? slope.dot(p) / p.squaredNorm() : 0.0;
+  c.bias_window_moving = c.bias_window_rotation_k > o.moving_k && p.norm() > o.moving_min_snr * sd;
+}
+
 Moments moments(const std::vector<ImuSample>& s, size_t b, size_t e) {
   Moments m;
   const double n = static_cast<double>(e - b);
@@ -214,6 +251,7 @@ ImuCalibration calibrate_imu(const std::vector<ImuSample>& s, const CalibrationO
     c.gyro_bias_sd_radps = (m.var_w / n).cwiseSqrt();
     c.bias_window_t0_s = p.t0_s;
     c.bias_window_s = p.duration_s;
+    window_rotation(s, p.begin, p.end, m.mean_w, o, c);
     break;
   }
   if (!c.still.empty()) {
@@ -255,6 +293,14 @@ ImuCalibration calibrate_imu(const std::vector<ImuSample>& s, const CalibrationO
         "no still period of %.1f s or more (variance test, %.1f s windows): the gyro bias at the start is not "
         "estimated from the log (the auto spec falls back to its floors)",
         o.min_still_s, o.window_s));
+  }
+  if (c.bias_window_moving) {
+    c.warnings.push_back(format(
+        "the first still period (%.1f-%.1f s) turns: its mean rate turns gravity in the sensor axes as a motion would "
+        "(%.0f deg/h across gravity, measured %.0f deg/h, k %.2f): not a bias (the auto spec keeps its floor)",
+        c.bias_window_t0_s, c.bias_window_t0_s + c.bias_window_s,
+        c.bias_window_predicted_rate_radps * kRadToDeg * 3600.0, c.bias_window_tilt_rate_radps * kRadToDeg * 3600.0,
+        c.bias_window_rotation_k));
   }
   if (c.gravity_estimated && std::abs(c.gravity_mps2 - kStandardGravity) > 0.3) {
     c.warnings.push_back(format("|f| at rest is %.3f m/s^2, not 9.81: check the accelerometer unit and scale",
@@ -304,7 +350,8 @@ ImuSpec spec_from_calibration(const ImuCalibration& c, const AutoSpecOptions& o)
   const double vrw = c.noise_estimated ? c.accel_noise_density.maxCoeff() : 0.0;
   s.gyro_arw = std::max(arw, o.gyro_noise_floor);
   s.accel_vrw = std::max(vrw, o.accel_noise_floor);
-  s.gyro_bias_initial = std::max(c.bias_estimated ? c.gyro_bias_radps.cwiseAbs().maxCoeff() : 0.0,
+  const bool window_is_bias = c.bias_estimated && !c.bias_window_moving;  // eq. 10.2
+  s.gyro_bias_initial = std::max(window_is_bias ? c.gyro_bias_radps.cwiseAbs().maxCoeff() : 0.0,
                                  o.gyro_bias_initial_floor);
   s.gyro_bias_instability = o.gyro_bias_instability;
   s.gyro_bias_tau_s = o.gyro_bias_tau_s;

@@ -35,6 +35,11 @@ struct CalibrationOptions {
   /// consumer accelerometer's zero-g offset (≈ 150 mg; the simulated unknown sensor's draws reach 50 mg).
   double max_gravity_error_mps2 = 1.5;
   double min_still_s = 1.0;             ///< shortest still period used for the bias [s]
+  /// The bias window turns (docs/ins.md eq. 10.2) when the accelerometer's rate of the gravity direction is nearer
+  /// the rate its mean gyro reading would give than zero (k > moving_k) and the two are told apart (the predicted
+  /// rate at least moving_min_snr of the measured rate's standard error).
+  double moving_k = 0.5;
+  double moving_min_snr = 3.0;
   double swing_rate_radps = 2.0;        ///< a footfall's swing peaks above this |ω| [rad/s] (foot: 3–15 rad/s)
   double min_stride_s = 0.4;            ///< swing peaks closer than this are one swing [s]
   double stance_rate_radps = 0.5;       ///< gait: samples below this |ω| (and |f| within 2 m/s² of g) count as stance
@@ -74,6 +79,15 @@ struct ImuCalibration {
   Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();     ///< mean rate of the first long still period (Earth rate included)
   Eigen::Vector3d gyro_bias_sd_radps = Eigen::Vector3d::Zero();  ///< its standard error (white noise)
   double bias_window_t0_s = 0.0, bias_window_s = 0.0;            ///< where it was taken
+  /// Does the bias window turn (docs/ins.md eq. 10.2)? The rate ġ of the unit specific force over the window (least
+  /// squares, sensor axes) against p = ū × ω̄, the rate at which the mean gyro reading would turn it if all of that
+  /// reading were motion: k = ġ·p / p·p is 0 for a bias (gravity stays put in the sensor axes) and 1 for a rotation.
+  /// Only the part of ω̄ across gravity is seen; a turn about the vertical is not.
+  double bias_window_rotation_k = 0.0;
+  double bias_window_tilt_rate_radps = 0.0;       ///< |ġ| [rad/s]
+  double bias_window_predicted_rate_radps = 0.0;  ///< |p| [rad/s]
+  double bias_window_tilt_rate_sd_radps = 0.0;    ///< standard error of each component of ġ [rad/s]
+  bool bias_window_moving = false;  ///< k > moving_k and |p| > moving_min_snr × sd: the mean rate is not a bias
   bool noise_estimated = false;
   Eigen::Vector3d gyro_noise_density = Eigen::Vector3d::Zero();   ///< [rad/s/√Hz] = ARW [rad/√s]
   Eigen::Vector3d accel_noise_density = Eigen::Vector3d::Zero();  ///< [m/s²/√Hz] = VRW [m/s/√s]
@@ -106,7 +120,8 @@ struct AutoSpecOptions {
   double accel_noise_floor = 2.12 / 60.0;                  ///< VRW floor [m/s/√s] (2.12 m/s/√h)
   /// The turn-on gyro bias σ covers the bias the first still period measured (|b| per axis, at least this floor):
   /// the run starts from that bias when the period is still, and a prior narrower than |b| would call the
-  /// measurement impossible (docs/ins.md eq. 6.1).
+  /// measurement impossible (docs/ins.md eq. 6.1). A window the accelerometer shows turning
+  /// (ImuCalibration::bias_window_moving, eq. 10.2) measured motion, not bias: the floor alone.
   double gyro_bias_initial_floor = 0.02 * kAutoDegToRad;   ///< [rad/s] (0.02 °/s = 72 °/h)
   double gyro_bias_instability = 10.0 * kAutoDegToRad / 3600.0;  ///< [rad/s] (10 °/h, a MEMS gyro's order)
   double gyro_bias_tau_s = 100.0;
@@ -117,7 +132,7 @@ struct AutoSpecOptions {
 };
 
 /// The IMU model of `imu.spec: auto`: the measured noise densities (at least the floors), the turn-on gyro bias σ
-/// covering the measured bias, generic MEMS bias stability, no scale-factor prior, and the ranges of any saturation
+/// covering the measured bias (unless its window turned), generic MEMS bias stability, no scale-factor prior, and the ranges of any saturation
 /// plateau found (else unknown: 0). Without a still period (calibration.noise_estimated false) the floors and
 /// gyro_bias_initial_floor are used.
 ImuSpec spec_from_calibration(const ImuCalibration& calibration, const AutoSpecOptions& options = {});

@@ -35,14 +35,14 @@ std::string calibration_yaml(const SelfCalibration& s, const std::string& imu_fi
   y += fmt::format("    accel_vrw_mps_per_sqrt_hr: {:.6g}     # max(white noise of the specific force at rest: {}; "
                    "floor 2.12)\n",
                    p.accel_vrw * 60.0, vrw_from);
-  y += fmt::format("    gyro_bias_initial_deg_per_s: {:.6g}  # covers the bias of the first still period ({}; "
-                   "floor 0.02)\n",
-                   p.gyro_bias_initial * dps,
-                   c.bias_estimated ? fmt::format("[{:.4f}, {:.4f}, {:.4f}] deg/s at {:.1f}-{:.1f} s",
-                                                  c.gyro_bias_radps.x() * dps, c.gyro_bias_radps.y() * dps,
-                                                  c.gyro_bias_radps.z() * dps, c.bias_window_t0_s,
-                                                  c.bias_window_t0_s + c.bias_window_s)
-                                    : std::string("not measured"));
+  const std::string window = fmt::format("[{:.4f}, {:.4f}, {:.4f}] deg/s at {:.1f}-{:.1f} s", c.gyro_bias_radps.x() * dps,
+                                         c.gyro_bias_radps.y() * dps, c.gyro_bias_radps.z() * dps, c.bias_window_t0_s,
+                                         c.bias_window_t0_s + c.bias_window_s);
+  y += fmt::format("    gyro_bias_initial_deg_per_s: {:.6g}  # {}; floor 0.02\n", p.gyro_bias_initial * dps,
+                   !c.bias_estimated        ? std::string("the bias was not measured")
+                   : c.bias_window_moving ? "the first still period turned (" + window + ", k " +
+                                                fmt::format("{:.2f}", c.bias_window_rotation_k) + "): not a bias"
+                                          : "covers the bias of the first still period (" + window + ")");
   y += fmt::format("    gyro_bias_instability_deg_per_hr: {:.6g}  # generic MEMS (not measurable in a short log)\n",
                    p.gyro_bias_instability * kRadToDeg * 3600.0);
   y += fmt::format("    gyro_bias_tau_s: {:.6g}\n", p.gyro_bias_tau_s);

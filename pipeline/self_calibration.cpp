@@ -94,7 +94,13 @@ nlohmann::ordered_json calibration_json(const ins::ImuCalibration& c) {
   if (c.bias_estimated) {
     j["gyro_bias_deg_per_h"] = vec(c.gyro_bias_radps, dph);
     j["gyro_bias_sd_deg_per_h"] = vec(c.gyro_bias_sd_radps, dph);
-    j["bias_window"] = {{"t0_s", c.bias_window_t0_s}, {"duration_s", c.bias_window_s}};
+    j["bias_window"] = {{"t0_s", c.bias_window_t0_s},
+                        {"duration_s", c.bias_window_s},
+                        {"tilt_rate_deg_per_h", c.bias_window_tilt_rate_radps * dph},
+                        {"predicted_tilt_rate_deg_per_h", c.bias_window_predicted_rate_radps * dph},
+                        {"tilt_rate_sd_deg_per_h", c.bias_window_tilt_rate_sd_radps * dph},
+                        {"rotation_k", c.bias_window_rotation_k},
+                        {"moving", c.bias_window_moving}};
   }
   j["gravity_estimated"] = c.gravity_estimated;
   if (c.gravity_estimated) {

@@ -17,6 +17,7 @@ namespace {
 
 using Eigen::Vector3d;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 constexpr double kG = 9.80665;
 
@@ -252,6 +253,66 @@ TEST(Calibration, AutoSpecCoversTheMeasuredBiasAndKeepsTheNoiseFloors) {
   EXPECT_NEAR(s.gyro_bias_initial, c.gyro_bias_radps.cwiseAbs().maxCoeff(), 1e-15);
   EXPECT_GT(s.gyro_bias_initial, 0.025);
   EXPECT_TRUE(s.problems().empty());
+}
+
+// docs/ins.md eq. 10.2: a still start whose mean rate is a bias leaves gravity put in the sensor axes (k ≈ 0); one
+// that turns slowly about a horizontal axis (a foot settling: LORD #34's first 1.5 s) turns gravity with it (k ≈ 1) and
+// its mean rate is not taken as the bias's size; a turn about the vertical alone cannot be told from a bias.
+std::vector<ImuSample> turning_start(const Vector3d& rate_radps, const Vector3d& bias_radps) {
+  Synthetic syn;
+  syn.bias_radps = bias_radps;
+  std::vector<ImuSample> s = syn.make();
+  // Over the still start (5 s) the sensor turns at `rate_radps` (sensor axes): the gravity direction in the sensor
+  // axes follows u̇ = u × ω, the gyro reads ω + bias + noise.
+  Vector3d u = Vector3d::UnitZ();
+  double t_prev = 0.0;
+  const double t0 = s.front().t.tow_s();
+  for (auto& m : s) {
+    const double t = m.t.tow_s() - t0;
+    if (t >= syn.still_start_s) break;
+    u = (u + u.cross(rate_radps) * (t - t_prev)).normalized();
+    t_prev = t;
+    m.omega_ib_b += rate_radps;
+    m.f_ib_b += kG * (u - Vector3d::UnitZ());
+  }
+  return s;
+}
+
+TEST(Calibration, AStillStartWithABiasDoesNotTurnGravity) {
+  const Vector3d bias(0.004, -0.007, 0.009);
+  const ImuCalibration c = calibrate_imu(turning_start(Vector3d::Zero(), bias));
+  ASSERT_TRUE(c.bias_estimated);
+  EXPECT_NEAR(c.bias_window_rotation_k, 0.0, 0.1);
+  EXPECT_FALSE(c.bias_window_moving);
+  EXPECT_GT(c.bias_window_predicted_rate_radps, 3.0 * c.bias_window_tilt_rate_sd_radps);  // the test could tell
+  EXPECT_NEAR(spec_from_calibration(c).gyro_bias_initial, c.gyro_bias_radps.cwiseAbs().maxCoeff(), 1e-15);
+  for (const auto& w : c.warnings) EXPECT_THAT(w, Not(HasSubstr("turns")));
+}
+
+TEST(Calibration, AStillStartThatTurnsIsMotionNotBias) {
+  const Vector3d bias(0.0005, -0.0003, 0.0002);    // 100 deg/h and less: a calibrated MEMS gyro
+  const Vector3d rate(0.0077, 0.0, 0.0);           // 0.44 deg/s about the sensor's x axis, across gravity
+  const ImuCalibration c = calibrate_imu(turning_start(rate, bias));
+  ASSERT_TRUE(c.bias_estimated);
+  EXPECT_NEAR(c.gyro_bias_radps.x(), rate.x() + bias.x(), 2e-3);  // the window's mean rate is mostly the turn
+  EXPECT_NEAR(c.bias_window_rotation_k, 1.0, 0.1);
+  EXPECT_TRUE(c.bias_window_moving);
+  const ImuSpec s = spec_from_calibration(c);
+  EXPECT_DOUBLE_EQ(s.gyro_bias_initial, AutoSpecOptions{}.gyro_bias_initial_floor);  // not the 0.0082 rad/s it read
+  bool warned = false;
+  for (const auto& w : c.warnings) warned |= w.find("the first still period (0.0-") == 0 && w.find("turns") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+TEST(Calibration, ATurnAboutTheVerticalAloneIsNotCalledMotion) {
+  const ImuCalibration c = calibrate_imu(turning_start(Vector3d(0.0, 0.0, 0.0077), Vector3d(0.0005, -0.0003, 0.0002)));
+  ASSERT_TRUE(c.bias_estimated);
+  // Only the bias's part across gravity is seen (p = u × ω̄ leaves the vertical turn out), and it does not turn
+  // gravity: k stays near 0 and the reading keeps covering the σ.
+  EXPECT_NEAR(c.bias_window_rotation_k, 0.0, 0.3);
+  EXPECT_FALSE(c.bias_window_moving);
+  EXPECT_GT(c.gyro_bias_radps.z(), 0.0077);
+  EXPECT_NEAR(spec_from_calibration(c).gyro_bias_initial, c.gyro_bias_radps.cwiseAbs().maxCoeff(), 1e-15);
 }
 
 }  // namespace

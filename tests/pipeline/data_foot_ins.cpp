@@ -264,13 +264,14 @@ TEST(DataFootIns, PyshoeTrialMeanError) {
   }
 }
 
-// LORD hallway experiment 35 with the committed configuration, scored at the measured footprints as scripts/foot_eval
-// does: reference = footprint k at the end of stance k (the stride time file), start-aligned; the solution epoch
-// nearest each footprint time (within 0.05 s) gives the error there.
-TEST(DataFootIns, LordFastWalkErrorAtTheFootprints) {
-  const std::string base = test::shared_data("foot_lord_gcp_hallway/SensorConnectData_35");
-  PEDNAV_REQUIRE_DATA(base + ".csv");
-  const auto out = temp_dir("lord_35");
+// A LORD hallway log (SensorConnectData_<number>) run with `cfg` and scored at the measured footprints as
+// scripts/foot_eval does: reference = footprint k at the end of stance k (the stride time file), start-aligned; the
+// solution epoch nearest each footprint time (within 0.05 s) gives the error there. The RMS over the footprints (and
+// their count in `n`); failures are test failures (1e9 then).
+double lord_footprint_rms(const std::string& number, const RunConfig& cfg, int& n) {
+  n = 0;
+  const std::string base = test::shared_data("foot_lord_gcp_hallway/SensorConnectData_" + number);
+  const auto out = temp_dir("lord_" + number);
   std::vector<double> times;
   {
     std::ifstream st(base + "_strideIndex_timestamp_gcpX_gcpY.csv"), gcp(base + "_GCP.csv");
@@ -291,10 +292,7 @@ TEST(DataFootIns, LordFastWalkErrorAtTheFootprints) {
       ref << "0," << t << ',' << x << ',' << y << ",0\n";
     }
   }
-  ASSERT_EQ(times.size(), 29u);
-  auto cfg = load_run_config(test::source_path("datasets/foot/lord_35.yaml"));
-  ASSERT_TRUE(cfg) << cfg.error().message;
-  ASSERT_TRUE(run_and_compare(*cfg, out, (out / "ref.csv").string()));
+  if (!run_and_compare(cfg, out, (out / "ref.csv").string())) return 1e9;
   std::vector<std::pair<double, double>> rows;  // (tow, horizontal error)
   {
     std::ifstream in(out / "cmp" / "errors.csv");
@@ -308,7 +306,6 @@ TEST(DataFootIns, LordFastWalkErrorAtTheFootprints) {
     }
   }
   double sum_sq = 0.0;
-  int n = 0;
   for (const double t : times) {
     const auto near = std::min_element(rows.begin(), rows.end(), [t](const auto& p, const auto& q) {
       return std::abs(p.first - t) < std::abs(q.first - t);
@@ -317,10 +314,50 @@ TEST(DataFootIns, LordFastWalkErrorAtTheFootprints) {
     sum_sq += near->second * near->second;
     ++n;
   }
-  ASSERT_EQ(n, 29);
-  const double rms_m = std::sqrt(sum_sq / n);
+  EXPECT_EQ(static_cast<size_t>(n), times.size()) << "footprints without a solution epoch";
+  return n > 0 ? std::sqrt(sum_sq / n) : 1e9;
+}
+
+// LORD hallway experiment 35 with the committed configuration at its 29 footprints.
+TEST(DataFootIns, LordFastWalkErrorAtTheFootprints) {
+  PEDNAV_REQUIRE_DATA(test::shared_data("foot_lord_gcp_hallway/SensorConnectData_35.csv"));
+  auto cfg = load_run_config(test::source_path("datasets/foot/lord_35.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  int n = 0;
+  const double rms_m = lord_footprint_rms("35", *cfg, n);
   std::printf("[lord 35] RMS at %d footprints %.4f m\n", n, rms_m);
+  ASSERT_EQ(n, 29);
   EXPECT_LT(rms_m, kMarginLarge * kLordFastWalkRms_m);
+}
+
+// LORD #34 with the minimal configuration (pyshoe_auto.yaml's filter keys: imu.spec and the threshold from the log;
+// its own file, format and start). Its first 1.5 s read 2302 deg/h and the accelerometer shows gravity turning with
+// that rate in the sensor axes (docs/ins.md eq. 10.2, k 1.3): the foot was settling, not still. Measured 2026-12-06:
+// footprint RMS 0.397 m (the committed gx5_25 configuration: 0.326 m); 0.845 m when the auto spec's turn-on σ covered
+// that reading (the run then started from a 0.6 deg/s "bias"). Bound: the measured figure + 5 %, below the old one.
+constexpr double kLord34MinimalRms_m = 0.397;
+
+TEST(DataFootIns, LordWalkWithTheMinimalConfigurationSettlingFootIsNotABias) {
+  PEDNAV_REQUIRE_DATA(test::shared_data("foot_lord_gcp_hallway/SensorConnectData_34.csv"));
+  auto base = load_run_config(test::source_path("datasets/foot/lord_34.yaml"));
+  ASSERT_TRUE(base) << base.error().message;
+  auto cfg = load_run_config(test::source_path("datasets/foot/pyshoe_auto.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  cfg->imu.file = base->imu.file;
+  cfg->imu.format = base->imu.format;
+  cfg->imu.format_preset = base->imu.format_preset;
+  cfg->initial = base->initial;
+  int n = 0;
+  const double rms_m = lord_footprint_rms("34", *cfg, n);
+  std::printf("[lord 34 minimal] RMS at %d footprints %.4f m\n", n, rms_m);
+  ASSERT_EQ(n, 25);
+  EXPECT_LT(rms_m, 1.05 * kLord34MinimalRms_m);
+  std::ifstream js(test::temp_dir_path("data_foot_ins_lord_34") / "run" / "summary.json");
+  const auto summary = nlohmann::json::parse(js);
+  const auto& window = summary["self_calibration"]["calibration"]["bias_window"];
+  EXPECT_TRUE(window["moving"].get<bool>());
+  EXPECT_NEAR(window["rotation_k"].get<double>(), 1.3, 0.2);
+  EXPECT_LT(summary["self_calibration"]["spec"]["gyro_bias_initial_deg_per_s"].get<double>(), 0.021);
 }
 
 // zupt.detector labels with the pyshoe format's stance column: the stance is exactly PyShoe's stored labels (its
