@@ -28,14 +28,15 @@ using namespace pednav::io;
 // The auto knobs (motion allowance 2.5, adaptive factor 4, swing 360 °/s, two-class split capped at 10) were chosen by
 // leave-one-session-out cross-validation on all 24 trials (scripts/pyshoe_loso): every figure here is in-sample for
 // that choice; the cross-validated (out-of-fold) figures are in docs/results.md "Out of the box" (all 24: median
-// 1.27x PyShoe's per-trial tuned error, worst 3.36x). Measured 2026-12-05 (Release; scripts/pyshoe_cv
+// 1.198x PyShoe's per-trial tuned error, worst 3.36x). Measured 2026-12-06 (Release; scripts/pyshoe_cv
 // datasets/foot/pyshoe_auto.yaml): `original` trials median 0.90x, worst 1.09x, 4/4 better than PyShoe with one
-// threshold; `added` trials median 1.365x, worst 2.59x (2018-02-09-11-22-01), 17/20. Bounds: measured + 5 %
+// threshold; `added` trials median 1.294x (1.365x before the turning-window test of docs/ins.md eq. 10.2), worst
+// 2.59x (2018-02-09-11-22-01), 17/20. Bounds: measured + 5 %
 // (deterministic runs; the margin is for another libm), counts exact. Issue 37's targets (median <= 1.0x, worst <=
 // 2.0x, >= 90 % better than one threshold) are NOT met and not asserted.
 constexpr double kOriginalMedianMax = 0.90 * 1.05;
 constexpr double kOriginalWorstMax = 1.09 * 1.05;
-constexpr double kAddedMedianMax = 1.365 * 1.05;
+constexpr double kAddedMedianMax = 1.294 * 1.05;
 constexpr double kAddedWorstMax = 2.59 * 1.05;
 constexpr int kAddedBeatsOneThresholdMin = 17;
 // x-io loops with the same configuration (held out: never used to choose an auto knob), measured 0.058 m / 0.156 m
