@@ -105,8 +105,10 @@ Expected<CalibrateResult> run_calibrate_command(const io::RunConfig& config, con
   }
   r.summary = fmt::format("{}: {:.1f} s at {:.1f} Hz; still {:.1f} s", config.imu.file, k.duration_s, k.rate_hz, k.still_s);
   if (k.bias_estimated) {
-    r.summary += fmt::format("; gyro bias [{:.3f}, {:.3f}, {:.3f}] deg/s", k.gyro_bias_radps.x() * kRadToDeg,
-                             k.gyro_bias_radps.y() * kRadToDeg, k.gyro_bias_radps.z() * kRadToDeg);
+    r.summary += fmt::format("; {} [{:.3f}, {:.3f}, {:.3f}] deg/s",
+                             k.bias_window_moving ? "first still period turning at" : "gyro bias",
+                             k.gyro_bias_radps.x() * kRadToDeg, k.gyro_bias_radps.y() * kRadToDeg,
+                             k.gyro_bias_radps.z() * kRadToDeg);
   }
   if (k.gravity_estimated) r.summary += fmt::format("; {} up ({:.1f} deg tilt)", k.up_axis, k.tilt_deg);
   if (k.noise_estimated) {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
 #include <optional>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -17,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "pipeline/calibrate_command.hpp"
 #include "pipeline/compare_command.hpp"
 #include "io/config.hpp"
 #include "pipeline/run_command.hpp"
@@ -358,6 +360,14 @@ TEST(DataFootIns, LordWalkWithTheMinimalConfigurationSettlingFootIsNotABias) {
   EXPECT_TRUE(window["moving"].get<bool>());
   EXPECT_NEAR(window["rotation_k"].get<double>(), 1.3, 0.2);
   EXPECT_LT(summary["self_calibration"]["spec"]["gyro_bias_initial_deg_per_s"].get<double>(), 0.021);
+  // `pednav calibrate` says so: the one-line summary, the warning and the comment of calibration.yaml's σ.
+  auto cal = run_calibrate_command(*cfg, (test::temp_dir_path("data_foot_ins_lord_34_cal")).string());
+  ASSERT_TRUE(cal) << cal.error().message;
+  EXPECT_NE(cal->summary.find("first still period turning at [-0.438, 0.445, 0.138] deg/s"), std::string::npos)
+      << cal->summary;
+  std::ifstream y(test::temp_dir_path("data_foot_ins_lord_34_cal") / "calibration.yaml");
+  const std::string yaml((std::istreambuf_iterator<char>(y)), std::istreambuf_iterator<char>());
+  EXPECT_NE(yaml.find("gyro_bias_initial_deg_per_s: 0.02  # the first still period turned"), std::string::npos) << yaml;
 }
 
 // zupt.detector labels with the pyshoe format's stance column: the stance is exactly PyShoe's stored labels (its
